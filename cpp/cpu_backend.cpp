@@ -1,0 +1,67 @@
+// CPU backend: the shared GLSL per-pixel code compiled as C++ (shader_cpp.hpp),
+// run over the image rows by a pool of threads.
+#include "backends.hpp"
+
+#include <algorithm>
+#include <atomic>
+#include <thread>
+#include <vector>
+
+namespace airlight {
+namespace shader {
+
+// The shared shader code becomes the member functions of this struct; its
+// members play the part of the GL uniforms and storage buffers.
+struct CpuShader {
+    const FrameUniforms& frame;
+    const PointLightGpu* point_lights;
+    const SurfaceGpu* surfaces;
+    Features features;
+
+    int point_light_count() const { return frame.film_counts.z; }
+    PointLightGpu point_light(int i) const { return point_lights[i]; }
+    int surface_count() const { return frame.film_counts.w; }
+    SurfaceGpu surface(int i) const { return surfaces[i]; }
+
+#define HAS_MEDIUM (features.medium)
+#define HAS_POINT_LIGHTS (features.point_lights)
+#define HAS_SURFACES (features.surfaces)
+#include "geometry.glsl"
+#include "shading.glsl"
+#undef HAS_MEDIUM
+#undef HAS_POINT_LIGHTS
+#undef HAS_SURFACES
+};
+
+}  // namespace shader
+
+void CpuBackend::render(const FrameData& data, Image& out) {
+    const int width = data.frame.film_counts.x;
+    const int height = data.frame.film_counts.y;
+    out.width = width;
+    out.height = height;
+    out.rgb.assign(size_t(width) * size_t(height) * 3, 0.0f);
+
+    const shader::CpuShader program{data.frame, data.point_lights.data(), data.surfaces.data(), data.features};
+    std::atomic<int> next_row{0};
+    auto worker = [&]() {
+        shader::CpuShader local = program;
+        for (int row = next_row++; row < height; row = next_row++) {
+            float* dst = out.rgb.data() + size_t(row) * size_t(width) * 3;
+            for (int x = 0; x < width; ++x) {
+                const glm::vec3 radiance = local.render_pixel(x, row);
+                dst[3 * x + 0] = radiance.r;
+                dst[3 * x + 1] = radiance.g;
+                dst[3 * x + 2] = radiance.b;
+            }
+        }
+    };
+    int n = threads > 0 ? threads : int(std::max(1u, std::thread::hardware_concurrency()));
+    n = std::min(n, height);
+    std::vector<std::thread> pool;
+    for (int i = 1; i < n; ++i) pool.emplace_back(worker);
+    worker();
+    for (std::thread& t : pool) t.join();
+}
+
+}  // namespace airlight

@@ -1,0 +1,18 @@
+// Built instead of gl_backend.cpp when EGL/OpenGL were not found at configure
+// time: the CPU backend still works and "auto" falls back to it.
+#include "backends.hpp"
+
+namespace airlight {
+
+struct GlBackend::State {};
+
+bool gl_backend_available(std::string* reason) {
+    if (reason != nullptr) *reason = "airlight was built without EGL/OpenGL";
+    return false;
+}
+
+GlBackend::GlBackend() { throw BackendUnavailable("airlight: GL backend unavailable: built without EGL/OpenGL"); }
+GlBackend::~GlBackend() = default;
+void GlBackend::render(const FrameData&, Image&) {}
+
+}  // namespace airlight

@@ -1,0 +1,144 @@
+// airlight._core: the pybind11 bridge. Scenes arrive as Python objects and are
+// converted to JSON values in C++ so that NaN/Inf survive to the validator;
+// scene errors become TypeError/ValueError naming the field.
+#include "airlight/image_io.hpp"
+#include "airlight/renderer.hpp"
+#include "airlight/scene_io.hpp"
+#include "scene_json.hpp"
+
+#include <pybind11/numpy.h>
+#include <pybind11/pybind11.h>
+
+#include <cstring>
+#include <memory>
+
+namespace py = pybind11;
+using airlight::Scene;
+
+namespace {
+
+// Python value -> JSON value. Unsupported types become a TypeError naming the
+// path, so that e.g. a set inside the scene is reported, not crashed on.
+nlohmann::json to_json(py::handle obj, const std::string& path, int depth = 0) {
+    if (depth > 64) throw py::value_error(path + ": nesting too deep");
+    if (obj.is_none()) return nullptr;
+    if (py::isinstance<py::bool_>(obj)) return obj.cast<bool>();
+    if (py::isinstance<py::int_>(obj)) {
+        try {
+            return obj.cast<long long>();
+        } catch (const py::cast_error&) {
+            return obj.cast<double>();  // huge integers: let the range checks speak
+        }
+    }
+    if (py::isinstance<py::float_>(obj)) return obj.cast<double>();
+    if (py::isinstance<py::str>(obj)) return obj.cast<std::string>();
+    if (py::isinstance<py::dict>(obj)) {
+        nlohmann::json out = nlohmann::json::object();
+        for (auto item : py::reinterpret_borrow<py::dict>(obj)) {
+            if (!py::isinstance<py::str>(item.first)) {
+                throw py::type_error(path + ": keys must be strings, got " +
+                                     std::string(py::str(py::type::of(item.first).attr("__name__"))));
+            }
+            const std::string key = item.first.cast<std::string>();
+            out[key] = to_json(item.second, path.empty() ? key : path + "." + key, depth + 1);
+        }
+        return out;
+    }
+    if (py::isinstance<py::list>(obj) || py::isinstance<py::tuple>(obj) || py::isinstance<py::array>(obj)) {
+        py::sequence seq = py::isinstance<py::array>(obj) ? py::sequence(obj.attr("tolist")())
+                                                          : py::reinterpret_borrow<py::sequence>(obj);
+        if (!py::isinstance<py::sequence>(seq)) return to_json(seq, path, depth + 1);  // 0-d array
+        nlohmann::json out = nlohmann::json::array();
+        for (size_t i = 0; i < seq.size(); ++i) {
+            out.push_back(to_json(seq[i], path + "[" + std::to_string(i) + "]", depth + 1));
+        }
+        return out;
+    }
+    // numpy scalars and other number-likes.
+    if (py::hasattr(obj, "__index__")) return obj.attr("__index__")().cast<long long>();
+    if (py::hasattr(obj, "__float__") && !py::isinstance<py::str>(obj)) return obj.attr("__float__")().cast<double>();
+    throw py::type_error((path.empty() ? std::string("scene") : path) + ": unsupported type " +
+                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+}
+
+Scene scene_from_python(py::handle obj) {
+    if (py::isinstance<py::str>(obj)) return airlight::parse_scene(obj.cast<std::string>());
+    return airlight::parse_scene_json(to_json(obj, ""));
+}
+
+py::array_t<float> image_to_numpy(airlight::Image&& image) {
+    auto* owned = new std::vector<float>(std::move(image.rgb));
+    py::capsule free_when_done(owned, [](void* p) { delete static_cast<std::vector<float>*>(p); });
+    return py::array_t<float>({image.height, image.width, 3}, owned->data(), free_when_done);
+}
+
+airlight::Image image_from_numpy(const py::array_t<float, py::array::c_style | py::array::forcecast>& a) {
+    if (a.ndim() != 3 || a.shape(2) != 3) throw py::value_error("radiance: expected shape (height, width, 3)");
+    airlight::Image image;
+    image.height = int(a.shape(0));
+    image.width = int(a.shape(1));
+    image.rgb.assign(a.data(), a.data() + a.size());
+    return image;
+}
+
+}  // namespace
+
+PYBIND11_MODULE(_core, m) {
+    m.doc() = "airlight native core (use the airlight package, not this module)";
+
+    py::register_exception_translator([](std::exception_ptr p) {
+        try {
+            if (p) std::rethrow_exception(p);
+        } catch (const airlight::SceneError& e) {
+            PyErr_SetString(e.kind() == airlight::SceneError::Kind::type ? PyExc_TypeError : PyExc_ValueError,
+                            e.what());
+        }
+    });
+    static py::exception<airlight::BackendUnavailable> backend_unavailable(m, "BackendUnavailableError",
+                                                                          PyExc_RuntimeError);
+
+    m.def("validate_scene", [](py::handle scene) { return airlight::scene_to_json(scene_from_python(scene), -1); },
+          "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");
+    m.def("load_scene_file", [](const std::string& path) { return airlight::scene_to_json(airlight::load_scene_file(path), -1); });
+    m.def("gl_backend_available", []() {
+        std::string reason;
+        const bool ok = airlight::gl_backend_available(&reason);
+        return py::make_tuple(ok, reason);
+    });
+    m.def("to_srgb8", [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, float exposure) {
+        const airlight::Image image = image_from_numpy(radiance);
+        std::vector<std::uint8_t> bytes;
+        try {
+            bytes = airlight::to_srgb8(image, exposure);
+        } catch (const std::invalid_argument& e) {
+            throw py::value_error(e.what());
+        }
+        py::array_t<std::uint8_t> out({image.height, image.width, 3});
+        std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
+        return out;
+    });
+
+    m.def("write_pfm", [](const std::string& path,
+                          const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
+        airlight::write_pfm(path, image_from_numpy(radiance));
+    });
+
+    py::class_<airlight::Renderer>(m, "Renderer")
+        .def(py::init([](const std::string& backend) {
+                 if (backend == "gl") return std::make_unique<airlight::Renderer>(airlight::Backend::gl);
+                 if (backend == "cpu") return std::make_unique<airlight::Renderer>(airlight::Backend::cpu);
+                 throw py::value_error("backend: must be 'gl' or 'cpu', got '" + backend + "'");
+             }),
+             py::arg("backend"))
+        .def_property_readonly("backend", [](const airlight::Renderer& r) { return airlight::backend_name(r.backend()); })
+        .def("set_cpu_threads", &airlight::Renderer::set_cpu_threads)
+        .def("render", [](airlight::Renderer& r, py::handle scene_obj) {
+            const Scene scene = scene_from_python(scene_obj);
+            airlight::Image image;
+            {
+                py::gil_scoped_release release;
+                image = r.render(scene);
+            }
+            return image_to_numpy(std::move(image));
+        });
+}

@@ -1,0 +1,458 @@
+// Scene JSON loading, validation and writing (format: README "Scene format").
+// Numbers are validated as doubles; bounds that must survive the conversion to
+// float (strict inequalities, camera and box degeneracy) are checked on the
+// float values, so that parse(write(scene)) reproduces the scene exactly.
+#include "scene_json.hpp"
+
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
+
+#include <algorithm>
+#include <cerrno>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <cstring>
+#include <limits>
+#include <optional>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace airlight {
+namespace {
+
+using json = nlohmann::json;
+using Kind = SceneError::Kind;
+using Names = std::vector<std::string>;
+
+constexpr double max_coordinate = 1e7;
+constexpr int max_film_size = 16384;
+constexpr double max_light_radius = 1e3;
+constexpr double default_light_radius = 0.05;
+constexpr double infinity = std::numeric_limits<double>::infinity();
+
+enum class LightType { point };
+
+template <class E>
+using NameTable = std::vector<std::pair<const char*, E>>;
+
+const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic}};
+const NameTable<LightType> light_types{{"point", LightType::point}};
+const NameTable<SurfaceType> surface_types{
+    {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
+
+// Keys allowed in a surface object of each type.
+Names surface_keys(SurfaceType type) {
+    switch (type) {
+    case SurfaceType::plane: return {"type", "albedo", "point", "normal"};
+    case SurfaceType::box: return {"type", "albedo", "min", "max"};
+    case SurfaceType::sphere: return {"type", "albedo", "center", "radius"};
+    }
+    return {};
+}
+
+[[noreturn]] void fail(Kind kind, const std::string& field, const std::string& message) {
+    throw SceneError(kind, field, message);
+}
+
+std::string join_path(const std::string& path, const std::string& key) {
+    return path.empty() ? key : path + "." + key;
+}
+
+std::string index_path(const std::string& path, std::size_t i) {
+    return path + "[" + std::to_string(i) + "]";
+}
+
+std::string join_names(const Names& names) {
+    std::string out;
+    for (const auto& n : names) out += (out.empty() ? "" : ", ") + n;
+    return out;
+}
+
+std::string format_number(double v) {
+    char buf[32];
+    std::snprintf(buf, sizeof buf, "%g", v);
+    return buf;
+}
+
+// JSON type names in the vocabulary of the Python API.
+std::string type_name(const json& j) {
+    switch (j.type()) {
+    case json::value_t::null: return "null";
+    case json::value_t::boolean: return "boolean";
+    case json::value_t::string: return "string";
+    case json::value_t::array: return "list";
+    case json::value_t::object: return "object";
+    case json::value_t::number_integer:
+    case json::value_t::number_unsigned:
+    case json::value_t::number_float: return "number";
+    default: return "unsupported value";
+    }
+}
+
+std::size_t edit_distance(const std::string& a, const std::string& b) {
+    std::vector<std::size_t> row(b.size() + 1);
+    for (std::size_t j = 0; j <= b.size(); ++j) row[j] = j;
+    for (std::size_t i = 1; i <= a.size(); ++i) {
+        std::size_t diag = row[0];
+        row[0] = i;
+        for (std::size_t j = 1; j <= b.size(); ++j) {
+            std::size_t above = row[j];
+            row[j] = std::min({row[j] + 1, row[j - 1] + 1, diag + (a[i - 1] != b[j - 1] ? 1 : 0)});
+            diag = above;
+        }
+    }
+    return row[b.size()];
+}
+
+// A JSON value with the dotted path it was found at.
+struct Value {
+    const json& j;
+    std::string field;
+};
+
+// An object being parsed.
+struct Obj {
+    const json& j;
+    std::string path;
+
+    explicit Obj(const Value& v) : j(v.j), path(v.field) {
+        if (!j.is_object()) fail(Kind::type, path, "expected an object, got " + type_name(j));
+    }
+
+    std::optional<Value> opt(const char* key) const {
+        auto it = j.find(key);
+        if (it == j.end()) return std::nullopt;
+        return Value{*it, join_path(path, key)};
+    }
+
+    Value req(const char* key) const {
+        auto v = opt(key);
+        if (!v) fail(Kind::value, join_path(path, key), "missing required key");
+        return *v;
+    }
+
+    // Rejects keys not in `allowed`, suggesting a known key within edit distance 2.
+    void check_keys(const Names& allowed) const {
+        for (const auto& item : j.items()) {
+            const std::string& key = item.key();
+            if (std::find(allowed.begin(), allowed.end(), key) != allowed.end()) continue;
+            std::size_t best = 3;
+            std::string message = "unknown key (allowed: " + join_names(allowed) + ")";
+            for (const auto& known : allowed) {
+                std::size_t d = edit_distance(key, known);
+                if (d < best) {
+                    best = d;
+                    message = "unknown key; did you mean '" + known + "'?";
+                }
+            }
+            fail(Kind::value, join_path(path, key), message);
+        }
+    }
+};
+
+// --- value readers -----------------------------------------------------------
+
+// A finite number (JSON integer or float; never a bool). `prefix` names the
+// element of a list ("element 1: ").
+double read_number(const Value& v, const std::string& prefix = "") {
+    if (!v.j.is_number()) fail(Kind::type, v.field, prefix + "expected a number, got " + type_name(v.j));
+    double x = v.j.get<double>();
+    if (!std::isfinite(x)) fail(Kind::value, v.field, prefix + "must be finite");
+    return x;
+}
+
+int read_int(const Value& v, int lo, int hi) {
+    double x = read_number(v);
+    if (x != std::floor(x)) fail(Kind::value, v.field, "must be an integer");
+    if (x < lo || x > hi)
+        fail(Kind::value, v.field, "must be in [" + std::to_string(lo) + ", " + std::to_string(hi) + "]");
+    return static_cast<int>(x);
+}
+
+// A scalar in (0, hi) or (0, hi], the bounds holding for the float value too.
+float read_positive(const Value& v, double hi, bool hi_inclusive) {
+    double x = read_number(v);
+    float f = static_cast<float>(x);
+    if (!(x > 0 && f > 0)) fail(Kind::value, v.field, "must be > 0");
+    if (!std::isfinite(f)) fail(Kind::value, v.field, "out of range for a 32-bit float");
+    bool ok = hi_inclusive ? (x <= hi && f <= hi) : (x < hi && f < hi);
+    if (!ok) fail(Kind::value, v.field, std::string(hi_inclusive ? "must be <= " : "must be < ") + format_number(hi));
+    return f;
+}
+
+std::string read_string(const Value& v) {
+    if (!v.j.is_string()) fail(Kind::type, v.field, "expected a string, got " + type_name(v.j));
+    return v.j.get<std::string>();
+}
+
+template <class E>
+E read_enum(const Value& v, const char* what, const NameTable<E>& table) {
+    std::string name = read_string(v);
+    Names allowed;
+    for (const auto& [n, e] : table) {
+        if (name == n) return e;
+        allowed.emplace_back(n);
+    }
+    fail(Kind::value, v.field,
+         "unknown " + std::string(what) + " type '" + name + "'; allowed: " + join_names(allowed));
+}
+
+template <class E>
+const char* name_of(const NameTable<E>& table, E e) {
+    for (const auto& [n, x] : table)
+        if (x == e) return n;
+    return "?";
+}
+
+std::string element_prefix(std::size_t i) { return "element " + std::to_string(i) + ": "; }
+
+// A point or direction: a list of exactly 3 finite numbers, |x| <= 1e7.
+glm::vec3 read_vec3(const Value& v) {
+    if (!v.j.is_array()) fail(Kind::type, v.field, "expected a list of 3 numbers, got " + type_name(v.j));
+    if (v.j.size() != 3)
+        fail(Kind::value, v.field, "expected a list of exactly 3 numbers, got " + std::to_string(v.j.size()));
+    glm::vec3 out;
+    for (std::size_t i = 0; i < 3; ++i) {
+        double x = read_number(Value{v.j[i], v.field}, element_prefix(i));
+        if (std::abs(x) > max_coordinate)
+            fail(Kind::value, v.field, element_prefix(i) + "absurd coordinate (|x| > 1e7)");
+        out[static_cast<glm::length_t>(i)] = static_cast<float>(x);
+    }
+    return out;
+}
+
+// An RGB value: a number (all channels) or a list of exactly 3, each in [0, hi].
+Rgb read_rgb(const Value& v, double hi = infinity) {
+    double c[3];
+    bool list = v.j.is_array();
+    if (list) {
+        if (v.j.size() != 3)
+            fail(Kind::value, v.field,
+                 "expected a number or a list of exactly 3 numbers, got " + std::to_string(v.j.size()));
+        for (std::size_t i = 0; i < 3; ++i) c[i] = read_number(Value{v.j[i], v.field}, element_prefix(i));
+    } else if (v.j.is_number()) {
+        c[0] = c[1] = c[2] = read_number(v);
+    } else {
+        fail(Kind::type, v.field, "expected a number or a list of 3 numbers, got " + type_name(v.j));
+    }
+    Rgb out;
+    for (std::size_t i = 0; i < 3; ++i) {
+        std::string prefix = list ? element_prefix(i) : "";
+        if (c[i] < 0) fail(Kind::value, v.field, prefix + "must be >= 0");
+        if (c[i] > hi) fail(Kind::value, v.field, prefix + "must be <= " + format_number(hi));
+        float f = static_cast<float>(c[i]);
+        if (!std::isfinite(f)) fail(Kind::value, v.field, prefix + "out of range for a 32-bit float");
+        out[static_cast<glm::length_t>(i)] = f;
+    }
+    return out;
+}
+
+// A list of objects, each parsed by `parse_item`; absent means empty.
+template <class T, class F>
+std::vector<T> read_list(const std::optional<Value>& v, F parse_item) {
+    std::vector<T> out;
+    if (!v) return out;
+    if (!v->j.is_array()) fail(Kind::type, v->field, "expected a list, got " + type_name(v->j));
+    for (std::size_t i = 0; i < v->j.size(); ++i)
+        out.push_back(parse_item(Obj(Value{v->j[i], index_path(v->field, i)})));
+    return out;
+}
+
+// --- objects -----------------------------------------------------------------
+
+Film parse_film(const Obj& o) {
+    o.check_keys({"width", "height"});
+    Film f;
+    f.width = read_int(o.req("width"), 1, max_film_size);
+    f.height = read_int(o.req("height"), 1, max_film_size);
+    return f;
+}
+
+Camera parse_camera(const Obj& o) {
+    o.check_keys({"position", "look_at", "up", "fov_y"});
+    Camera c;
+    c.position = read_vec3(o.req("position"));
+    c.look_at = read_vec3(o.req("look_at"));
+    c.up = read_vec3(o.req("up"));
+    c.fov_y_degrees = read_positive(o.req("fov_y"), 180.0, false);
+    // Degeneracy, on the stored float values.
+    glm::dvec3 position(c.position), view = glm::dvec3(c.look_at) - position, up(c.up);
+    if (glm::length(view) < 1e-6 * std::max(1.0, glm::length(position)))
+        fail(Kind::value, join_path(o.path, "look_at"), "look_at equals position");
+    double up_length = glm::length(up);
+    if (up_length == 0 || glm::length(glm::cross(glm::normalize(view), up)) < 1e-6 * up_length)
+        fail(Kind::value, join_path(o.path, "up"), "up is zero or parallel to the view direction");
+    return c;
+}
+
+Phase parse_phase(const Obj& o) {
+    o.check_keys({"type"});
+    Phase p;
+    p.type = read_enum(o.req("type"), "phase", phase_types);
+    return p;
+}
+
+Medium parse_medium(const Obj& o) {
+    o.check_keys({"sigma_t", "albedo", "phase"});
+    Medium m;
+    m.sigma_t = read_rgb(o.req("sigma_t"));
+    if (auto v = o.opt("albedo")) m.albedo = read_rgb(*v, 1.0);
+    if (auto v = o.opt("phase")) m.phase = parse_phase(Obj(*v));
+    return m;
+}
+
+PointLight parse_light(const Obj& o) {
+    read_enum(o.req("type"), "light", light_types);
+    o.check_keys({"type", "position", "intensity", "radius"});
+    PointLight l;
+    l.position = read_vec3(o.req("position"));
+    l.intensity = read_rgb(o.req("intensity"));
+    l.radius = static_cast<float>(default_light_radius);
+    if (auto v = o.opt("radius")) l.radius = read_positive(*v, max_light_radius, true);
+    return l;
+}
+
+Surface parse_surface(const Obj& o) {
+    Surface s;
+    s.type = read_enum(o.req("type"), "surface", surface_types);
+    o.check_keys(surface_keys(s.type));
+    if (auto v = o.opt("albedo")) s.albedo = read_rgb(*v, 1.0);
+    switch (s.type) {
+    case SurfaceType::plane: {
+        s.point = read_vec3(o.req("point"));
+        Value nv = o.req("normal");
+        glm::dvec3 n(read_vec3(nv));
+        double length = glm::length(n);
+        if (length < 1e-12) fail(Kind::value, nv.field, "normal must be nonzero");
+        // Normals already unit to float precision are kept, so that reloading
+        // a written scene gives the same bits.
+        s.normal = std::abs(length - 1.0) > 1e-6 ? glm::vec3(n / length) : glm::vec3(n);
+        break;
+    }
+    case SurfaceType::box: {
+        s.box_min = read_vec3(o.req("min"));
+        Value max = o.req("max");
+        s.box_max = read_vec3(max);
+        if (!(s.box_min.x < s.box_max.x && s.box_min.y < s.box_max.y && s.box_min.z < s.box_max.z))
+            fail(Kind::value, max.field, "max must be greater than min on every axis");
+        break;
+    }
+    case SurfaceType::sphere:
+        s.center = read_vec3(o.req("center"));
+        s.radius = read_positive(o.req("radius"), infinity, false);
+        break;
+    }
+    return s;
+}
+
+// --- writing -----------------------------------------------------------------
+
+// The shortest decimal that reads back as `f`, as a double (so that the JSON
+// text shows "0.05", not "0.05000000074505806").
+double json_number(float f) {
+    char buf[32];
+    for (int digits = 6; digits <= 9; ++digits) {
+        std::snprintf(buf, sizeof buf, "%.*g", digits, static_cast<double>(f));
+        double d = std::strtod(buf, nullptr);
+        if (static_cast<float>(d) == f) return d;
+    }
+    return static_cast<double>(f);  // unreachable: 9 digits always round-trip
+}
+
+json json_vec3(const glm::vec3& v) {
+    return json::array({json_number(v.x), json_number(v.y), json_number(v.z)});
+}
+
+}  // namespace
+
+Scene parse_scene_json(const json& j) {
+    if (!j.is_object()) fail(Kind::type, "", "scene must be a JSON object");
+    Obj top(Value{j, ""});
+    top.check_keys({"film", "camera", "medium", "lights", "surfaces", "background"});
+    Scene s;
+    s.film = parse_film(Obj(top.req("film")));
+    s.camera = parse_camera(Obj(top.req("camera")));
+    if (auto v = top.opt("medium"); v && !v->j.is_null()) {
+        s.has_medium = true;
+        s.medium = parse_medium(Obj(*v));
+    }
+    s.point_lights = read_list<PointLight>(top.opt("lights"), parse_light);
+    s.surfaces = read_list<Surface>(top.opt("surfaces"), parse_surface);
+    if (auto v = top.opt("background")) s.background = read_rgb(*v);
+    return s;
+}
+
+json scene_to_json_value(const Scene& s) {
+    json j;
+    j["film"] = {{"width", s.film.width}, {"height", s.film.height}};
+    j["camera"] = {{"position", json_vec3(s.camera.position)},
+                   {"look_at", json_vec3(s.camera.look_at)},
+                   {"up", json_vec3(s.camera.up)},
+                   {"fov_y", json_number(s.camera.fov_y_degrees)}};
+    if (s.has_medium) {
+        j["medium"] = {{"sigma_t", json_vec3(s.medium.sigma_t)},
+                       {"albedo", json_vec3(s.medium.albedo)},
+                       {"phase", {{"type", name_of(phase_types, s.medium.phase.type)}}}};
+    } else {
+        j["medium"] = nullptr;
+    }
+    j["lights"] = json::array();
+    for (const auto& l : s.point_lights) {
+        j["lights"].push_back({{"type", name_of(light_types, LightType::point)},
+                               {"position", json_vec3(l.position)},
+                               {"intensity", json_vec3(l.intensity)},
+                               {"radius", json_number(l.radius)}});
+    }
+    j["surfaces"] = json::array();
+    for (const auto& sf : s.surfaces) {
+        json o = {{"type", name_of(surface_types, sf.type)}, {"albedo", json_vec3(sf.albedo)}};
+        switch (sf.type) {
+        case SurfaceType::plane:
+            o["point"] = json_vec3(sf.point);
+            o["normal"] = json_vec3(sf.normal);
+            break;
+        case SurfaceType::box:
+            o["min"] = json_vec3(sf.box_min);
+            o["max"] = json_vec3(sf.box_max);
+            break;
+        case SurfaceType::sphere:
+            o["center"] = json_vec3(sf.center);
+            o["radius"] = json_number(sf.radius);
+            break;
+        }
+        j["surfaces"].push_back(std::move(o));
+    }
+    j["background"] = json_vec3(s.background);
+    return j;
+}
+
+Scene parse_scene(const std::string& json_text) {
+    json j;
+    try {
+        j = json::parse(json_text);
+    } catch (const json::exception& e) {
+        fail(Kind::value, "", std::string("invalid JSON: ") + e.what());
+    }
+    return parse_scene_json(j);
+}
+
+Scene load_scene_file(const std::string& path) {
+    std::FILE* f = std::fopen(path.c_str(), "rb");
+    if (!f) fail(Kind::value, "path", "cannot open '" + path + "': " + std::strerror(errno));
+    std::string text;
+    char buf[1 << 16];
+    std::size_t n;
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+    int error = std::ferror(f) ? errno : 0;
+    std::fclose(f);
+    if (error) fail(Kind::value, "path", "cannot read '" + path + "': " + std::strerror(error));
+    return parse_scene(text);
+}
+
+std::string scene_to_json(const Scene& scene, int indent) {
+    return scene_to_json_value(scene).dump(indent);
+}
+
+}  // namespace airlight

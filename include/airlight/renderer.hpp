@@ -1,0 +1,60 @@
+// Rendering a scene to linear radiance with the GL or the CPU backend.
+#pragma once
+
+#include "airlight/scene.hpp"
+
+#include <memory>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace airlight {
+
+enum class Backend { cpu, gl };
+
+const char* backend_name(Backend backend);
+
+// Thrown when the GL backend cannot run here (no EGL, no OpenGL 4.5 context,
+// or a build without EGL); the message says why.
+class BackendUnavailable : public std::runtime_error {
+public:
+    using std::runtime_error::runtime_error;
+};
+
+// Linear radiance, W/(m^2 sr): `rgb` holds width * height RGB triples, row 0
+// is the top row of the image.
+struct Image {
+    int width = 0;
+    int height = 0;
+    std::vector<float> rgb;
+};
+
+// True when an OpenGL 4.5 core context can be created through EGL here; on
+// false, `reason` (if given) says why. Setting AIRLIGHT_DISABLE_GL=1 makes it
+// false, to exercise the CPU fallback.
+bool gl_backend_available(std::string* reason = nullptr);
+
+// Keeps what is expensive to set up (the GL context, compiled shader variants,
+// and later the scattering tables) across frames, so that animations pay the
+// set-up once. Not thread safe: use one Renderer per thread.
+class Renderer {
+public:
+    // Throws BackendUnavailable for Backend::gl when GL cannot run here.
+    explicit Renderer(Backend backend);
+    ~Renderer();
+    Renderer(const Renderer&) = delete;
+    Renderer& operator=(const Renderer&) = delete;
+
+    Backend backend() const;
+    Image render(const Scene& scene);
+
+    // Number of CPU threads used by the CPU backend (default: all cores).
+    void set_cpu_threads(int threads);
+
+    struct Impl;
+
+private:
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace airlight

@@ -1,0 +1,81 @@
+// The scene description: what is rendered. Plain data, validated on load
+// (scene_io.hpp); the README's "Scene format" section documents every key.
+#pragma once
+
+#include <glm/vec3.hpp>
+
+#include <string>
+#include <vector>
+
+namespace airlight {
+
+// Linear RGB triple (radiance, intensity, coefficients, albedo), per channel.
+using Rgb = glm::vec3;
+
+struct Film {
+    int width = 320;
+    int height = 240;
+};
+
+// Pinhole camera. fov_y is the full vertical field of view in degrees; the
+// aspect ratio comes from the film; right-handed, y up.
+struct Camera {
+    glm::vec3 position{0.0f, 1.7f, 0.0f};
+    glm::vec3 look_at{0.0f, 1.7f, -10.0f};
+    glm::vec3 up{0.0f, 1.0f, 0.0f};
+    float fov_y_degrees = 60.0f;
+};
+
+enum class PhaseType { isotropic };
+
+struct Phase {
+    PhaseType type = PhaseType::isotropic;
+};
+
+// Homogeneous participating medium filling all space (MODELS.md conventions):
+// sigma_t extinction in 1/m, albedo = sigma_s / sigma_t.
+struct Medium {
+    Rgb sigma_t{0.0f};
+    Rgb albedo{1.0f};
+    Phase phase;
+
+    Rgb sigma_s() const { return sigma_t * albedo; }
+};
+
+// Isotropic point light: radiant intensity in W/sr. The lamp is a small
+// emitting sphere of the given radius (metres) so that a pixel looking
+// straight at it sees a finite radiance I / (pi r^2).
+struct PointLight {
+    glm::vec3 position{0.0f};
+    Rgb intensity{0.0f};
+    float radius = 0.05f;
+};
+
+enum class SurfaceType { plane, box, sphere };
+
+// Lambertian surfaces. Field use by type:
+//   plane:  point, normal (unit after loading)
+//   box:    box_min, box_max (axis aligned)
+//   sphere: center, radius
+struct Surface {
+    SurfaceType type = SurfaceType::plane;
+    glm::vec3 point{0.0f};
+    glm::vec3 normal{0.0f, 1.0f, 0.0f};
+    glm::vec3 box_min{0.0f};
+    glm::vec3 box_max{0.0f};
+    glm::vec3 center{0.0f};
+    float radius = 0.0f;
+    Rgb albedo{0.5f};
+};
+
+struct Scene {
+    Film film;
+    Camera camera;
+    bool has_medium = false;  // false: clear air
+    Medium medium;
+    std::vector<PointLight> point_lights;
+    std::vector<Surface> surfaces;
+    Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium)
+};
+
+}  // namespace airlight

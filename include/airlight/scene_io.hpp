@@ -1,0 +1,39 @@
+// Loading, validating and writing scenes in the JSON format of the README.
+#pragma once
+
+#include "airlight/scene.hpp"
+
+#include <stdexcept>
+#include <string>
+
+namespace airlight {
+
+// Raised for any invalid scene. `field` is the dotted path of the offending
+// value ("camera.fov_y", "lights[2].intensity"); `kind` says whether the value
+// had the wrong JSON type (Python TypeError) or a bad value (ValueError).
+class SceneError : public std::runtime_error {
+public:
+    enum class Kind { type, value };
+    SceneError(Kind kind, std::string field, const std::string& message)
+        : std::runtime_error(field.empty() ? message : field + ": " + message),
+          kind_(kind), field_(std::move(field)) {}
+    Kind kind() const { return kind_; }
+    const std::string& field() const { return field_; }
+
+private:
+    Kind kind_;
+    std::string field_;
+};
+
+// Parses and validates a scene from JSON text. Throws SceneError.
+Scene parse_scene(const std::string& json_text);
+
+// Reads a JSON file and parses it. Throws SceneError (a missing or unreadable
+// file is a value error on the field "path").
+Scene load_scene_file(const std::string& path);
+
+// Writes a scene back as JSON with every default filled in and every RGB
+// value expanded to a triple; parse_scene(scene_to_json(s)) == s.
+std::string scene_to_json(const Scene& scene, int indent = 2);
+
+}  // namespace airlight

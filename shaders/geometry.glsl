@@ -1,0 +1,110 @@
+// Ray geometry shared by both backends: camera rays and ray/surface
+// intersections. Requires the accessors frame, surface_count(), surface(i),
+// point_light_count(), point_light(i) (declared per backend).
+
+CONST float PI = 3.14159265358979f;
+CONST float NO_HIT = 3.0e38f;  // "infinitely far" distance along a ray
+
+// Unit direction of the ray through the centre of pixel (x, row), row 0 on top.
+vec3 camera_ray_direction(int x, int row) {
+    float width = float(frame.film_counts.x);
+    float height = float(frame.film_counts.y);
+    float sx = 2.0f * (float(x) + 0.5f) / width - 1.0f;
+    float sy = 1.0f - 2.0f * (float(row) + 0.5f) / height;
+    return normalize(vec3(frame.camera_forward) + sx * vec3(frame.camera_right) +
+                     sy * vec3(frame.camera_up));
+}
+
+// 1/x without dividing by zero (slab tests with axis-parallel rays).
+float safe_inverse(float x) {
+    return 1.0f / (abs(x) > 1.0e-20f ? x : (x >= 0.0f ? 1.0e-20f : -1.0e-20f));
+}
+
+// Nearest intersection distance t > t_min of a ray with surface s, or NO_HIT.
+// The geometric normal (not yet facing the ray) goes to `normal`.
+float intersect_surface(SurfaceGpu s, vec3 origin, vec3 dir, float t_min, OUT(vec3) normal) {
+    int type = int(s.albedo_type.w + 0.5f);
+    normal = vec3(0.0f, 1.0f, 0.0f);
+    if (type == SURFACE_PLANE) {
+        vec3 n = vec3(s.p1);
+        float denom = dot(n, dir);
+        if (abs(denom) < 1.0e-12f) return NO_HIT;
+        float t = dot(vec3(s.p0) - origin, n) / denom;
+        normal = n;
+        return t > t_min ? t : NO_HIT;
+    }
+    if (type == SURFACE_BOX) {
+        vec3 inv = vec3(safe_inverse(dir.x), safe_inverse(dir.y), safe_inverse(dir.z));
+        vec3 ta = (vec3(s.p0) - origin) * inv;
+        vec3 tb = (vec3(s.p1) - origin) * inv;
+        vec3 t_lo = min(ta, tb);
+        vec3 t_hi = max(ta, tb);
+        float t_near = max(max(t_lo.x, t_lo.y), t_lo.z);
+        float t_far = min(min(t_hi.x, t_hi.y), t_hi.z);
+        if (t_near > t_far) return NO_HIT;
+        // Entering face when the origin is outside, leaving face when inside.
+        bool outside = t_near > t_min;
+        float t = outside ? t_near : t_far;
+        if (t <= t_min) return NO_HIT;
+        vec3 t_face = outside ? t_lo : t_hi;
+        if (t_face.x == t) normal = vec3(-sign(dir.x), 0.0f, 0.0f);
+        else if (t_face.y == t) normal = vec3(0.0f, -sign(dir.y), 0.0f);
+        else normal = vec3(0.0f, 0.0f, -sign(dir.z));
+        return t;
+    }
+    // Sphere: |origin + t dir - c|^2 = r^2 with |dir| = 1; the stable form
+    // of the roots avoids cancellation for distant spheres.
+    vec3 oc = origin - vec3(s.p0);
+    float r = s.p1.x;
+    float b = dot(oc, dir);
+    vec3 perp = oc - b * dir;  // component of oc across the ray
+    float disc = r * r - dot(perp, perp);
+    if (disc < 0.0f) return NO_HIT;
+    float h = sqrt(disc);
+    float t = -b - h;
+    if (t <= t_min) t = -b + h;
+    if (t <= t_min) return NO_HIT;
+    normal = (origin + t * dir - vec3(s.p0)) / r;
+    return t;
+}
+
+// Closest surface along the ray: returns its distance (NO_HIT if none), its
+// index and its normal turned to face the ray origin.
+float trace_surfaces(vec3 origin, vec3 dir, OUT(int) hit_index, OUT(vec3) hit_normal) {
+    float best = NO_HIT;
+    hit_index = -1;
+    hit_normal = vec3(0.0f, 1.0f, 0.0f);
+    for (int i = 0; i < surface_count(); ++i) {
+        vec3 n;
+        float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
+        if (t < best) {
+            best = t;
+            hit_index = i;
+            hit_normal = n;
+        }
+    }
+    if (dot(hit_normal, dir) > 0.0f) hit_normal = -hit_normal;
+    return best;
+}
+
+// True when any surface blocks the segment origin + t dir, 0 < t < max_t.
+bool segment_occluded(vec3 origin, vec3 dir, float max_t) {
+    for (int i = 0; i < surface_count(); ++i) {
+        vec3 n;
+        if (intersect_surface(surface(i), origin, dir, 0.0f, n) < max_t) return true;
+    }
+    return false;
+}
+
+// Distance to the near side of lamp `i`'s sphere along the ray, or NO_HIT.
+// A camera inside the sphere does not see that lamp's core.
+float intersect_lamp(PointLightGpu light, vec3 origin, vec3 dir) {
+    vec3 oc = origin - vec3(light.position_radius);
+    float r = light.position_radius.w;
+    float b = dot(oc, dir);
+    if (dot(oc, oc) <= r * r || b >= 0.0f) return NO_HIT;
+    vec3 perp = oc - b * dir;
+    float disc = r * r - dot(perp, perp);
+    if (disc < 0.0f) return NO_HIT;
+    return -b - sqrt(disc);
+}

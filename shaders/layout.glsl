@@ -1,0 +1,36 @@
+// Data layout shared by the GL backend (uniform and storage buffers) and the
+// CPU backend (the same structs compiled as C++ against GLM). Only vec4/ivec4
+// members, so std140/std430 and C++ agree byte for byte.
+
+// Per-frame constants (std140 uniform block on the GPU).
+struct FrameUniforms {
+    vec4 camera_position;  // xyz: pinhole position
+    vec4 camera_right;     // xyz: right vector scaled by tan(fov_y / 2) * aspect
+    vec4 camera_up;        // xyz: up vector scaled by tan(fov_y / 2)
+    vec4 camera_forward;   // xyz: unit view direction
+    vec4 sigma_t;          // rgb: medium extinction (1/m); 0 in clear air
+    vec4 sigma_s;          // rgb: medium scattering (1/m) = albedo * sigma_t
+    vec4 background;       // rgb: radiance of escaping rays, before attenuation
+    ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
+};
+
+// An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting
+// radiant intensity I (W/sr), hence radiance I / (pi r^2) on its disc.
+struct PointLightGpu {
+    vec4 position_radius;  // xyz: centre, w: radius (m)
+    vec4 intensity;        // rgb: W/sr
+};
+
+// A Lambertian surface. type (albedo_type.w, exact small integer):
+//   0 plane:  p0 = point, p1 = unit normal
+//   1 box:    p0 = min corner, p1 = max corner
+//   2 sphere: p0 = centre, p1.x = radius
+struct SurfaceGpu {
+    vec4 p0;
+    vec4 p1;
+    vec4 albedo_type;
+};
+
+CONST int SURFACE_PLANE = 0;
+CONST int SURFACE_BOX = 1;
+CONST int SURFACE_SPHERE = 2;

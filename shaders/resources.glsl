@@ -1,0 +1,10 @@
+// GL-only: the resources behind the accessors that the shared code uses.
+// (The CPU backend defines the same accessors over its own arrays.)
+layout(std140, binding = 0) uniform FrameBlock { FrameUniforms frame; };
+layout(std430, binding = 1) readonly buffer PointLightBlock { PointLightGpu point_lights[]; };
+layout(std430, binding = 2) readonly buffer SurfaceBlock { SurfaceGpu surfaces[]; };
+
+int point_light_count() { return frame.film_counts.z; }
+PointLightGpu point_light(int i) { return point_lights[i]; }
+int surface_count() { return frame.film_counts.w; }
+SurfaceGpu surface(int i) { return surfaces[i]; }

@@ -1,0 +1,505 @@
+// Tests of the scene loader (cpp/scene_io.cpp): every validation rule of the
+// README "Scene format", the README example, and exact round trips.
+// Self-contained: prints each failure, exits non-zero if any.
+#include "airlight/scene_io.hpp"
+#include "scene_json.hpp"
+
+#include <glm/geometric.hpp>
+
+#include <cmath>
+#include <cstdio>
+#include <functional>
+#include <limits>
+#include <random>
+#include <string>
+#include <vector>
+
+using airlight::SceneError;
+using json = nlohmann::json;
+using Kind = SceneError::Kind;
+
+namespace {
+
+int checks = 0;
+int failures = 0;
+
+void check(bool ok, const std::string& what, const char* file, int line) {
+    ++checks;
+    if (!ok) {
+        ++failures;
+        std::printf("FAIL %s:%d: %s\n", file, line, what.c_str());
+    }
+}
+
+#define CHECK(cond) check((cond), #cond, __FILE__, __LINE__)
+#define CHECK_MSG(cond, msg) check((cond), std::string(#cond) + " [" + (msg) + "]", __FILE__, __LINE__)
+
+const double nan = std::numeric_limits<double>::quiet_NaN();
+const double inf = std::numeric_limits<double>::infinity();
+
+// The README example, verbatim.
+const char* readme_example =
+    R"({"film": {"width": 320, "height": 240}, "camera": {"position": [0, 1.7, 0], "look_at": [0, 1.7, -10], )"
+    R"("up": [0, 1, 0], "fov_y": 60}, "medium": {"sigma_t": 0.05, "albedo": 1.0, "phase": {"type": "isotropic"}}, )"
+    R"("lights": [{"type": "point", "position": [3, 5, -20], "intensity": [100, 90, 70]}], "surfaces": [{"type": )"
+    R"("plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": [0.3, 0.3, 0.3]}, {"type": "box", "min": )"
+    R"([-8, 0, -40], "max": [-4, 12, -25], "albedo": 0.5}], "background": [0, 0, 0]})";
+
+// The README example plus a sphere (surfaces[2]) and a second light.
+json base_scene() {
+    json j = json::parse(readme_example);
+    j["surfaces"].push_back({{"type", "sphere"}, {"center", {0, 1, -15}}, {"radius", 1.5}});
+    j["lights"].push_back({{"type", "point"}, {"position", {0, 3, -5}}, {"intensity", 10}, {"radius", 0.1}});
+    return j;
+}
+
+bool same(const glm::vec3& a, const glm::vec3& b) { return a.x == b.x && a.y == b.y && a.z == b.z; }
+
+// Exact (bitwise-value) equality of two scenes; unused medium fields ignored.
+bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
+    bool ok = a.film.width == b.film.width && a.film.height == b.film.height &&
+              same(a.camera.position, b.camera.position) && same(a.camera.look_at, b.camera.look_at) &&
+              same(a.camera.up, b.camera.up) && a.camera.fov_y_degrees == b.camera.fov_y_degrees &&
+              a.has_medium == b.has_medium && same(a.background, b.background) &&
+              a.point_lights.size() == b.point_lights.size() && a.surfaces.size() == b.surfaces.size();
+    if (!ok) return false;
+    if (a.has_medium && !(same(a.medium.sigma_t, b.medium.sigma_t) && same(a.medium.albedo, b.medium.albedo) &&
+                          a.medium.phase.type == b.medium.phase.type))
+        return false;
+    for (std::size_t i = 0; i < a.point_lights.size(); ++i) {
+        const auto &x = a.point_lights[i], &y = b.point_lights[i];
+        if (!(same(x.position, y.position) && same(x.intensity, y.intensity) && x.radius == y.radius)) return false;
+    }
+    for (std::size_t i = 0; i < a.surfaces.size(); ++i) {
+        const auto &x = a.surfaces[i], &y = b.surfaces[i];
+        if (!(x.type == y.type && same(x.point, y.point) && same(x.normal, y.normal) && same(x.box_min, y.box_min) &&
+              same(x.box_max, y.box_max) && same(x.center, y.center) && x.radius == y.radius &&
+              same(x.albedo, y.albedo)))
+            return false;
+    }
+    return true;
+}
+
+struct BadCase {
+    const char* name;
+    std::function<void(json&)> mutate;
+    Kind kind;
+    const char* field;
+    const char* message;  // substring of the message
+};
+
+const std::vector<BadCase> bad_cases = {
+    // Top level.
+    {"scene not an object", [](json& j) { j = json::array({1}); }, Kind::type, "", "scene must be a JSON object"},
+    {"scene null", [](json& j) { j = nullptr; }, Kind::type, "", "scene must be a JSON object"},
+    {"typo key", [](json& j) { j["camra"] = j["camera"]; },
+     Kind::value, "camra", "unknown key; did you mean 'camera'?"},
+    {"unknown key", [](json& j) { j["zzzzzzz"] = 1; }, Kind::value, "zzzzzzz", "unknown key"},
+    {"typo lights", [](json& j) { j["light"] = json::array(); }, Kind::value, "light", "did you mean 'lights'?"},
+    {"missing film", [](json& j) { j.erase("film"); }, Kind::value, "film", "missing required key"},
+    {"missing camera", [](json& j) { j.erase("camera"); }, Kind::value, "camera", "missing required key"},
+    {"film not object", [](json& j) { j["film"] = 5; }, Kind::type, "film", "expected an object"},
+    {"camera null", [](json& j) { j["camera"] = nullptr; }, Kind::type, "camera", "expected an object"},
+    // Film.
+    {"width 0", [](json& j) { j["film"]["width"] = 0; }, Kind::value, "film.width", "must be in [1, 16384]"},
+    {"width negative", [](json& j) { j["film"]["width"] = -5; }, Kind::value, "film.width", "must be in"},
+    {"width huge", [](json& j) { j["film"]["width"] = 16385; }, Kind::value, "film.width", "must be in"},
+    {"height uint64", [](json& j) { j["film"]["height"] = 18446744073709551615ull; },
+     Kind::value, "film.height", "must be in"},
+    {"width float", [](json& j) { j["film"]["width"] = 320.5; }, Kind::value, "film.width", "must be an integer"},
+    {"width 1e300", [](json& j) { j["film"]["width"] = 1e300; }, Kind::value, "film.width", "must be in"},
+    {"width string", [](json& j) { j["film"]["width"] = "320"; },
+     Kind::type, "film.width", "expected a number, got string"},
+    {"width bool", [](json& j) { j["film"]["width"] = true; },
+     Kind::type, "film.width", "expected a number, got boolean"},
+    {"width NaN", [](json& j) { j["film"]["width"] = nan; }, Kind::value, "film.width", "must be finite"},
+    {"height missing", [](json& j) { j["film"].erase("height"); }, Kind::value, "film.height", "missing required key"},
+    {"film extra", [](json& j) { j["film"]["depth"] = 3; }, Kind::value, "film.depth", "unknown key"},
+    {"film typo", [](json& j) { j["film"]["widht"] = 3; }, Kind::value, "film.widht", "did you mean 'width'?"},
+    // Camera.
+    {"fov 0", [](json& j) { j["camera"]["fov_y"] = 0; }, Kind::value, "camera.fov_y", "must be > 0"},
+    {"fov negative", [](json& j) { j["camera"]["fov_y"] = -10; }, Kind::value, "camera.fov_y", "must be > 0"},
+    {"fov 180", [](json& j) { j["camera"]["fov_y"] = 180; }, Kind::value, "camera.fov_y", "must be < 180"},
+    {"fov 180 as float", [](json& j) { j["camera"]["fov_y"] = 179.999999999; },
+     Kind::value, "camera.fov_y", "must be < 180"},
+    {"fov NaN", [](json& j) { j["camera"]["fov_y"] = nan; }, Kind::value, "camera.fov_y", "must be finite"},
+    {"fov inf", [](json& j) { j["camera"]["fov_y"] = inf; }, Kind::value, "camera.fov_y", "must be finite"},
+    {"fov string", [](json& j) { j["camera"]["fov_y"] = "60"; },
+     Kind::type, "camera.fov_y", "expected a number, got string"},
+    {"fov bool", [](json& j) { j["camera"]["fov_y"] = false; }, Kind::type, "camera.fov_y", "expected a number"},
+    {"fov missing", [](json& j) { j["camera"].erase("fov_y"); }, Kind::value, "camera.fov_y", "missing required key"},
+    {"fov typo", [](json& j) { j["camera"]["fovy"] = 60; }, Kind::value, "camera.fovy", "did you mean 'fov_y'?"},
+    {"look_at missing", [](json& j) { j["camera"].erase("look_at"); },
+     Kind::value, "camera.look_at", "missing required key"},
+    {"position short", [](json& j) { j["camera"]["position"] = {0, 1}; }, Kind::value, "camera.position", "exactly 3"},
+    {"position long", [](json& j) { j["camera"]["position"] = {0, 1, 2, 3}; },
+     Kind::value, "camera.position", "exactly 3"},
+    {"position string", [](json& j) { j["camera"]["position"] = "origin"; },
+     Kind::type, "camera.position", "expected a list"},
+    {"position scalar", [](json& j) { j["camera"]["position"] = 0; }, Kind::type, "camera.position", "expected a list"},
+    {"position null", [](json& j) { j["camera"]["position"] = nullptr; }, Kind::type, "camera.position", "got null"},
+    {"position bool elem", [](json& j) { j["camera"]["position"] = {0, true, 0}; },
+     Kind::type, "camera.position", "expected a number, got boolean"},
+    {"position string elem", [](json& j) { j["camera"]["position"] = {0, "1", 0}; },
+     Kind::type, "camera.position", "expected a number, got string"},
+    {"position NaN", [](json& j) { j["camera"]["position"] = {0, nan, 0}; },
+     Kind::value, "camera.position", "must be finite"},
+    {"position -inf", [](json& j) { j["camera"]["position"] = {-inf, 0, 0}; },
+     Kind::value, "camera.position", "must be finite"},
+    {"position absurd", [](json& j) { j["camera"]["position"] = {0, 2e7, 0}; },
+     Kind::value, "camera.position", "absurd coordinate"},
+    {"look_at absurd", [](json& j) { j["camera"]["look_at"] = {0, 0, -1.5e7}; },
+     Kind::value, "camera.look_at", "absurd coordinate"},
+    {"up NaN", [](json& j) { j["camera"]["up"] = {0, nan, 0}; }, Kind::value, "camera.up", "must be finite"},
+    {"look_at = position", [](json& j) { j["camera"]["look_at"] = {0, 1.7, 0}; },
+     Kind::value, "camera.look_at", "look_at equals position"},
+    {"look_at ~ position", [](json& j) { j["camera"]["look_at"] = {0, 1.7, 1e-8}; },
+     Kind::value, "camera.look_at", "look_at equals position"},
+    {"up zero", [](json& j) { j["camera"]["up"] = {0, 0, 0}; }, Kind::value, "camera.up", "parallel"},
+    {"up parallel", [](json& j) { j["camera"]["up"] = {0, 0, -1}; }, Kind::value, "camera.up", "parallel"},
+    {"up antiparallel", [](json& j) { j["camera"]["up"] = {0, 0, 5}; }, Kind::value, "camera.up", "parallel"},
+    // Medium.
+    {"medium scalar", [](json& j) { j["medium"] = 5; }, Kind::type, "medium", "expected an object"},
+    {"medium list", [](json& j) { j["medium"] = json::array(); }, Kind::type, "medium", "expected an object"},
+    {"sigma_t missing", [](json& j) { j["medium"].erase("sigma_t"); },
+     Kind::value, "medium.sigma_t", "missing required key"},
+    {"sigma_t negative", [](json& j) { j["medium"]["sigma_t"] = -1; }, Kind::value, "medium.sigma_t", "must be >= 0"},
+    {"sigma_t negative elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, -0.1, 0}; },
+     Kind::value, "medium.sigma_t", "must be >= 0"},
+    {"sigma_t short", [](json& j) { j["medium"]["sigma_t"] = {0.1, 0.2}; }, Kind::value, "medium.sigma_t", "exactly 3"},
+    {"sigma_t string", [](json& j) { j["medium"]["sigma_t"] = "thick"; }, Kind::type, "medium.sigma_t", "got string"},
+    {"sigma_t bool", [](json& j) { j["medium"]["sigma_t"] = true; }, Kind::type, "medium.sigma_t", "got boolean"},
+    {"sigma_t bool elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, false, 0.1}; },
+     Kind::type, "medium.sigma_t", "expected a number, got boolean"},
+    {"sigma_t NaN", [](json& j) { j["medium"]["sigma_t"] = nan; }, Kind::value, "medium.sigma_t", "must be finite"},
+    {"sigma_t inf elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, inf, 0.1}; },
+     Kind::value, "medium.sigma_t", "must be finite"},
+    {"sigma_t beyond float", [](json& j) { j["medium"]["sigma_t"] = 1e39; },
+     Kind::value, "medium.sigma_t", "32-bit float"},
+    {"medium albedo > 1", [](json& j) { j["medium"]["albedo"] = 1.5; }, Kind::value, "medium.albedo", "must be <= 1"},
+    {"medium albedo elem > 1", [](json& j) { j["medium"]["albedo"] = {0.5, 0.5, 1.01}; },
+     Kind::value, "medium.albedo", "must be <= 1"},
+    {"medium albedo < 0", [](json& j) { j["medium"]["albedo"] = -0.1; }, Kind::value, "medium.albedo", "must be >= 0"},
+    {"medium typo", [](json& j) { j["medium"]["sigma"] = 1; }, Kind::value, "medium.sigma", "did you mean 'sigma_t'?"},
+    {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "hg"; },
+     Kind::value, "medium.phase.type", "isotropic"},
+    {"phase type missing", [](json& j) { j["medium"]["phase"] = json::object(); },
+     Kind::value, "medium.phase.type", "missing required key"},
+    {"phase type number", [](json& j) { j["medium"]["phase"]["type"] = 3; },
+     Kind::type, "medium.phase.type", "expected a string"},
+    {"phase not object", [](json& j) { j["medium"]["phase"] = "isotropic"; },
+     Kind::type, "medium.phase", "expected an object"},
+    {"phase extra key", [](json& j) { j["medium"]["phase"]["g"] = 0.5; }, Kind::value, "medium.phase.g", "unknown key"},
+    // Lights.
+    {"lights object", [](json& j) { j["lights"] = json::object(); }, Kind::type, "lights", "expected a list"},
+    {"lights null", [](json& j) { j["lights"] = nullptr; }, Kind::type, "lights", "expected a list"},
+    {"light not object", [](json& j) { j["lights"][0] = 5; }, Kind::type, "lights[0]", "expected an object"},
+    {"light type missing", [](json& j) { j["lights"][0].erase("type"); },
+     Kind::value, "lights[0].type", "missing required key"},
+    {"light type unknown", [](json& j) { j["lights"][0]["type"] = "spot"; }, Kind::value, "lights[0].type", "point"},
+    {"light type number", [](json& j) { j["lights"][0]["type"] = 1; },
+     Kind::type, "lights[0].type", "expected a string"},
+    {"light position missing", [](json& j) { j["lights"][0].erase("position"); },
+     Kind::value, "lights[0].position", "missing required key"},
+    {"light position absurd", [](json& j) { j["lights"][0]["position"] = {1e8, 0, 0}; },
+     Kind::value, "lights[0].position", "absurd coordinate"},
+    {"light intensity missing", [](json& j) { j["lights"][1].erase("intensity"); },
+     Kind::value, "lights[1].intensity", "missing required key"},
+    {"light intensity negative", [](json& j) { j["lights"][0]["intensity"] = -1; },
+     Kind::value, "lights[0].intensity", "must be >= 0"},
+    {"light intensity long", [](json& j) { j["lights"][0]["intensity"] = {1, 2, 3, 4}; },
+     Kind::value, "lights[0].intensity", "exactly 3"},
+    {"light intensity NaN", [](json& j) { j["lights"][0]["intensity"] = {1, 2, nan}; },
+     Kind::value, "lights[0].intensity", "must be finite"},
+    {"light radius 0", [](json& j) { j["lights"][0]["radius"] = 0; }, Kind::value, "lights[0].radius", "must be > 0"},
+    {"light radius negative", [](json& j) { j["lights"][0]["radius"] = -1; },
+     Kind::value, "lights[0].radius", "must be > 0"},
+    {"light radius tiny", [](json& j) { j["lights"][0]["radius"] = 1e-60; },
+     Kind::value, "lights[0].radius", "must be > 0"},
+    {"light radius huge", [](json& j) { j["lights"][0]["radius"] = 1000.5; },
+     Kind::value, "lights[0].radius", "must be <= 1000"},
+    {"light radius NaN", [](json& j) { j["lights"][1]["radius"] = nan; },
+     Kind::value, "lights[1].radius", "must be finite"},
+    {"light radius string", [](json& j) { j["lights"][0]["radius"] = "big"; },
+     Kind::type, "lights[0].radius", "expected a number"},
+    {"light extra key", [](json& j) { j["lights"][0]["colour"] = 1; }, Kind::value, "lights[0].colour", "unknown key"},
+    {"light typo", [](json& j) { j["lights"][0]["intensty"] = 1; },
+     Kind::value, "lights[0].intensty", "did you mean 'intensity'?"},
+    {"third light",
+     [](json& j) { j["lights"].push_back({{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", {1, -2, 3}}}); },
+     Kind::value, "lights[2].intensity", "must be >= 0"},
+    // Surfaces.
+    {"surfaces string", [](json& j) { j["surfaces"] = "x"; }, Kind::type, "surfaces", "expected a list"},
+    {"surface not object", [](json& j) { j["surfaces"][1] = json::array(); },
+     Kind::type, "surfaces[1]", "expected an object"},
+    {"surface type missing", [](json& j) { j["surfaces"][0].erase("type"); },
+     Kind::value, "surfaces[0].type", "missing required key"},
+    {"surface type unknown", [](json& j) { j["surfaces"][0]["type"] = "disk"; },
+     Kind::value, "surfaces[0].type", "plane, box, sphere"},
+    {"surface type bool", [](json& j) { j["surfaces"][0]["type"] = true; },
+     Kind::type, "surfaces[0].type", "expected a string"},
+    {"surface albedo > 1", [](json& j) { j["surfaces"][0]["albedo"] = 2; },
+     Kind::value, "surfaces[0].albedo", "must be <= 1"},
+    {"surface albedo NaN", [](json& j) { j["surfaces"][1]["albedo"] = nan; },
+     Kind::value, "surfaces[1].albedo", "must be finite"},
+    {"surface albedo string", [](json& j) { j["surfaces"][1]["albedo"] = "grey"; },
+     Kind::type, "surfaces[1].albedo", "got string"},
+    {"plane normal missing", [](json& j) { j["surfaces"][0].erase("normal"); },
+     Kind::value, "surfaces[0].normal", "missing required key"},
+    {"plane point missing", [](json& j) { j["surfaces"][0].erase("point"); },
+     Kind::value, "surfaces[0].point", "missing required key"},
+    {"plane normal zero", [](json& j) { j["surfaces"][0]["normal"] = {0, 0, 0}; },
+     Kind::value, "surfaces[0].normal", "nonzero"},
+    {"plane normal tiny", [](json& j) { j["surfaces"][0]["normal"] = {1e-14, 0, 0}; },
+     Kind::value, "surfaces[0].normal", "nonzero"},
+    {"plane normal short", [](json& j) { j["surfaces"][0]["normal"] = {0, 1}; },
+     Kind::value, "surfaces[0].normal", "exactly 3"},
+    {"plane point absurd", [](json& j) { j["surfaces"][0]["point"] = {0, -1e9, 0}; },
+     Kind::value, "surfaces[0].point", "absurd coordinate"},
+    {"plane with radius", [](json& j) { j["surfaces"][0]["radius"] = 1; },
+     Kind::value, "surfaces[0].radius", "unknown key"},
+    {"plane with min", [](json& j) { j["surfaces"][0]["min"] = {0, 0, 0}; },
+     Kind::value, "surfaces[0].min", "unknown key"},
+    {"box min missing", [](json& j) { j["surfaces"][1].erase("min"); },
+     Kind::value, "surfaces[1].min", "missing required key"},
+    {"box max missing", [](json& j) { j["surfaces"][1].erase("max"); },
+     Kind::value, "surfaces[1].max", "missing required key"},
+    {"box inverted", [](json& j) { j["surfaces"][1]["max"] = {-9, 12, -25}; },
+     Kind::value, "surfaces[1].max", "greater than min"},
+    {"box flat", [](json& j) { j["surfaces"][1]["max"] = {-4, 12, -40}; },
+     Kind::value, "surfaces[1].max", "greater than min"},
+    {"box with normal", [](json& j) { j["surfaces"][1]["normal"] = {0, 1, 0}; },
+     Kind::value, "surfaces[1].normal", "unknown key"},
+    {"box min NaN", [](json& j) { j["surfaces"][1]["min"] = {nan, 0, 0}; },
+     Kind::value, "surfaces[1].min", "must be finite"},
+    {"sphere radius 0", [](json& j) { j["surfaces"][2]["radius"] = 0; },
+     Kind::value, "surfaces[2].radius", "must be > 0"},
+    {"sphere radius negative", [](json& j) { j["surfaces"][2]["radius"] = -1; },
+     Kind::value, "surfaces[2].radius", "must be > 0"},
+    {"sphere radius inf", [](json& j) { j["surfaces"][2]["radius"] = inf; },
+     Kind::value, "surfaces[2].radius", "must be finite"},
+    {"sphere radius beyond float", [](json& j) { j["surfaces"][2]["radius"] = 1e300; },
+     Kind::value, "surfaces[2].radius", "32-bit float"},
+    {"sphere radius missing", [](json& j) { j["surfaces"][2].erase("radius"); },
+     Kind::value, "surfaces[2].radius", "missing required key"},
+    {"sphere center missing", [](json& j) { j["surfaces"][2].erase("center"); },
+     Kind::value, "surfaces[2].center", "missing required key"},
+    {"sphere center bool", [](json& j) { j["surfaces"][2]["center"] = true; },
+     Kind::type, "surfaces[2].center", "expected a list"},
+    {"sphere typo", [](json& j) { j["surfaces"][2]["centre"] = {0, 0, 0}; },
+     Kind::value, "surfaces[2].centre", "did you mean 'center'?"},
+    {"sphere with point", [](json& j) { j["surfaces"][2]["point"] = {0, 0, 0}; },
+     Kind::value, "surfaces[2].point", "unknown key"},
+    // Background.
+    {"background negative", [](json& j) { j["background"] = -1; }, Kind::value, "background", "must be >= 0"},
+    {"background string", [](json& j) { j["background"] = "black"; }, Kind::type, "background", "got string"},
+    {"background NaN", [](json& j) { j["background"] = {0, 0, nan}; }, Kind::value, "background", "must be finite"},
+    {"background null", [](json& j) { j["background"] = nullptr; }, Kind::type, "background", "got null"},
+};
+
+void test_bad_cases() {
+    for (const auto& c : bad_cases) {
+        json j = base_scene();
+        c.mutate(j);
+        bool thrown = false;
+        try {
+            airlight::parse_scene_json(j);
+        } catch (const SceneError& e) {
+            thrown = true;
+            std::string got = std::string("field '") + e.field() + "', message '" + e.what() + "'";
+            CHECK_MSG(e.kind() == c.kind, std::string(c.name) + ": " + got);
+            CHECK_MSG(e.field() == c.field, std::string(c.name) + ": expected field '" + c.field + "', " + got);
+            CHECK_MSG(std::string(e.what()).find(c.message) != std::string::npos,
+                      std::string(c.name) + ": expected '" + c.message + "' in " + got);
+        }
+        CHECK_MSG(thrown, std::string(c.name) + ": no SceneError");
+    }
+}
+
+// Expects parse_scene(text) to throw a SceneError of the given kind and field.
+void check_text_error(const std::string& text, Kind kind, const std::string& field, const std::string& message) {
+    try {
+        airlight::parse_scene(text);
+        CHECK_MSG(false, "no SceneError for: " + text);
+    } catch (const SceneError& e) {
+        CHECK_MSG(e.kind() == kind, text);
+        CHECK_MSG(e.field() == field, text + " -> field '" + e.field() + "'");
+        CHECK_MSG(std::string(e.what()).find(message) != std::string::npos, text + " -> " + e.what());
+    }
+}
+
+void test_text_errors() {
+    check_text_error("{\"film\": ", Kind::value, "", "invalid JSON");
+    check_text_error("", Kind::value, "", "invalid JSON");
+    check_text_error("{\"film\": {\"width\": NaN}}", Kind::value, "", "invalid JSON");
+    check_text_error("[1, 2, 3]", Kind::type, "", "scene must be a JSON object");
+    check_text_error("\"scene\"", Kind::type, "", "scene must be a JSON object");
+    check_text_error("{}", Kind::value, "film", "missing required key");
+}
+
+void test_readme_example() {
+    airlight::Scene s = airlight::parse_scene(readme_example);
+    CHECK(s.film.width == 320 && s.film.height == 240);
+    CHECK(same(s.camera.position, {0.0f, 1.7f, 0.0f}));
+    CHECK(same(s.camera.look_at, {0.0f, 1.7f, -10.0f}));
+    CHECK(same(s.camera.up, {0.0f, 1.0f, 0.0f}));
+    CHECK(s.camera.fov_y_degrees == 60.0f);
+    CHECK(s.has_medium);
+    CHECK(same(s.medium.sigma_t, glm::vec3(0.05f)));
+    CHECK(same(s.medium.albedo, glm::vec3(1.0f)));
+    CHECK(s.medium.phase.type == airlight::PhaseType::isotropic);
+    CHECK(s.point_lights.size() == 1);
+    CHECK(same(s.point_lights.at(0).position, {3.0f, 5.0f, -20.0f}));
+    CHECK(same(s.point_lights.at(0).intensity, {100.0f, 90.0f, 70.0f}));
+    CHECK(s.point_lights.at(0).radius == 0.05f);
+    CHECK(s.surfaces.size() == 2);
+    CHECK(s.surfaces.at(0).type == airlight::SurfaceType::plane);
+    CHECK(same(s.surfaces.at(0).point, glm::vec3(0.0f)));
+    CHECK(same(s.surfaces.at(0).normal, {0.0f, 1.0f, 0.0f}));
+    CHECK(same(s.surfaces.at(0).albedo, glm::vec3(0.3f)));
+    CHECK(s.surfaces.at(1).type == airlight::SurfaceType::box);
+    CHECK(same(s.surfaces.at(1).box_min, {-8.0f, 0.0f, -40.0f}));
+    CHECK(same(s.surfaces.at(1).box_max, {-4.0f, 12.0f, -25.0f}));
+    CHECK(same(s.surfaces.at(1).albedo, glm::vec3(0.5f)));
+    CHECK(same(s.background, glm::vec3(0.0f)));
+}
+
+void test_defaults_and_accepted_forms() {
+    json j = base_scene();
+    j.erase("medium");
+    j.erase("background");
+    j["surfaces"][0].erase("albedo");
+    j["film"]["width"] = 320.0;                       // integral float
+    j["film"]["height"] = 16384u;                     // unsigned, upper bound
+    j["lights"][0]["radius"] = 1000;                  // upper bound inclusive
+    j["surfaces"][0]["normal"] = {0, 2, 0};           // normalised on load
+    j["surfaces"][1]["albedo"] = {0, 1, 0.25};        // albedo bounds inclusive
+    j["camera"]["fov_y"] = 179.5;
+    j["camera"]["up"] = {0.5, 3, 0.1};                // need not be orthogonal
+    airlight::Scene s = airlight::parse_scene_json(j);
+    CHECK(!s.has_medium);
+    CHECK(same(s.background, glm::vec3(0.0f)));
+    CHECK(same(s.surfaces.at(0).albedo, glm::vec3(0.5f)));
+    CHECK(s.film.width == 320 && s.film.height == 16384);
+    CHECK(s.point_lights.at(0).radius == 1000.0f);
+    CHECK(s.point_lights.at(1).radius == 0.1f);
+    CHECK(same(s.point_lights.at(1).intensity, glm::vec3(10.0f)));  // scalar broadcast
+    CHECK(same(s.surfaces.at(0).normal, {0.0f, 1.0f, 0.0f}));
+    CHECK(same(s.surfaces.at(1).albedo, {0.0f, 1.0f, 0.25f}));
+    CHECK(s.surfaces.at(2).type == airlight::SurfaceType::sphere);
+    CHECK(same(s.surfaces.at(2).center, {0.0f, 1.0f, -15.0f}));
+    CHECK(s.surfaces.at(2).radius == 1.5f);
+    CHECK(s.camera.fov_y_degrees == 179.5f);
+
+    j["medium"] = nullptr;  // null medium: clear air
+    j["lights"] = json::array();
+    j.erase("surfaces");
+    s = airlight::parse_scene_json(j);
+    CHECK(!s.has_medium && s.point_lights.empty() && s.surfaces.empty());
+
+    j = json::parse(readme_example);
+    j["medium"] = {{"sigma_t", {0.1, 0.2, 0.3}}};  // albedo and phase default
+    j["background"] = 0.25;
+    s = airlight::parse_scene_json(j);
+    CHECK(s.has_medium && same(s.medium.sigma_t, {0.1f, 0.2f, 0.3f}) && same(s.medium.albedo, glm::vec3(1.0f)));
+    CHECK(s.medium.phase.type == airlight::PhaseType::isotropic);
+    CHECK(same(s.background, glm::vec3(0.25f)));
+    j["camera"]["position"] = {1e7, -1e7, 0};  // coordinate bound inclusive
+    j["camera"]["look_at"] = {0, 0, 0};
+    CHECK(airlight::parse_scene_json(j).camera.position.x == 1e7f);
+}
+
+void test_round_trip() {
+    airlight::Scene s = airlight::parse_scene_json(base_scene());
+    s.medium.sigma_t = {0.1f, 1.0f / 3.0f, 2e-7f};
+    s.background = {0.01f, 0.02f, 1e5f};
+    std::string text = airlight::scene_to_json(s);
+    airlight::Scene r = airlight::parse_scene(text);
+    CHECK(same_scene(s, r));
+    CHECK(airlight::scene_to_json(r) == text);
+    CHECK(text.find("0.05") != std::string::npos);  // shortest float digits
+    CHECK(text.find("0.0500000") == std::string::npos);
+
+    // Every default written; surfaces carry only their own keys.
+    json v = airlight::scene_to_json_value(airlight::parse_scene(readme_example));
+    CHECK(v["lights"][0]["radius"].is_number());
+    CHECK(v["medium"]["albedo"].is_array() && v["medium"]["albedo"].size() == 3);
+    CHECK(v["medium"]["phase"]["type"] == "isotropic");
+    CHECK(v["surfaces"][1]["albedo"].is_array());
+    CHECK(v["background"].is_array() && v["background"].size() == 3);
+    CHECK(!v["surfaces"][0].contains("radius") && !v["surfaces"][0].contains("min"));
+    CHECK(v["surfaces"][1].contains("min") && !v["surfaces"][1].contains("normal"));
+    CHECK(v["film"]["width"].is_number_integer());
+
+    // No medium: written as null.
+    airlight::Scene clear = s;
+    clear.has_medium = false;
+    v = airlight::scene_to_json_value(clear);
+    CHECK(v.contains("medium") && v["medium"].is_null());
+    CHECK(same_scene(clear, airlight::parse_scene_json(v)));
+
+    // Random scenes: parse -> write -> parse gives identical floats.
+    std::mt19937 rng(1234);
+    std::uniform_real_distribution<double> coord(-1e3, 1e3), unit(0.0, 1.0), expo(-8.0, 4.0);
+    auto vec = [&] { return json::array({coord(rng), coord(rng), coord(rng)}); };
+    int mismatches = 0, rejected = 0;
+    for (int i = 0; i < 2000; ++i) {
+        json j = json::parse(readme_example);
+        j["camera"] = {{"position", vec()}, {"look_at", vec()}, {"up", vec()}, {"fov_y", 0.01 + 179.98 * unit(rng)}};
+        j["medium"] = {{"sigma_t", std::pow(10.0, expo(rng))}, {"albedo", {unit(rng), unit(rng), unit(rng)}}};
+        j["lights"][0]["radius"] = 1e-3 + unit(rng);
+        j["surfaces"][0]["normal"] = vec();
+        j["surfaces"].push_back({{"type", "sphere"}, {"center", vec()}, {"radius", std::pow(10.0, expo(rng))}});
+        airlight::Scene a;
+        try {
+            a = airlight::parse_scene_json(j);
+        } catch (const SceneError&) {
+            ++rejected;
+            continue;
+        }
+        airlight::Scene b = airlight::parse_scene(airlight::scene_to_json(a, -1));
+        if (!same_scene(a, b)) ++mismatches;
+        float len = glm::length(a.surfaces[0].normal);
+        if (std::abs(len - 1.0f) > 2e-6f) ++mismatches;
+    }
+    CHECK_MSG(mismatches == 0, std::to_string(mismatches) + " mismatches");
+    CHECK(rejected < 10);
+}
+
+void test_files() {
+    try {
+        airlight::load_scene_file("/nonexistent/scene.json");
+        CHECK(false);
+    } catch (const SceneError& e) {
+        CHECK(e.kind() == Kind::value && e.field() == "path");
+    }
+    try {
+        airlight::load_scene_file("/tmp");  // a directory
+        CHECK(false);
+    } catch (const SceneError& e) {
+        CHECK(e.kind() == Kind::value && e.field() == "path");
+    }
+    std::string path = "/tmp/airlight_test_scene_" + std::to_string(std::random_device{}()) + ".json";
+    if (std::FILE* f = std::fopen(path.c_str(), "wb")) {
+        std::fputs(readme_example, f);
+        std::fclose(f);
+        airlight::Scene s = airlight::load_scene_file(path);
+        CHECK(s.film.width == 320 && s.surfaces.size() == 2);
+        std::remove(path.c_str());
+    } else {
+        CHECK(false);
+    }
+}
+
+}  // namespace
+
+int main() {
+    test_bad_cases();
+    test_text_errors();
+    test_readme_example();
+    test_defaults_and_accepted_forms();
+    test_round_trip();
+    test_files();
+    std::printf("%d bad-input cases, %d checks, %d failures\n", static_cast<int>(bad_cases.size()), checks, failures);
+    return failures == 0 ? 0 : 1;
+}
