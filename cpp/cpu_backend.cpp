@@ -16,8 +16,14 @@ struct CpuShader {
     const FrameUniforms& frame;
     const PointLightGpu* point_lights;
     const SurfaceGpu* surfaces;
+    const float* airlight_tail_texels;  // null unless the scene needs the table
+    const float* surface_glow_texels;
     Features features;
 
+    float table_texel(int table, int x, int y) const {
+        return table == TABLE_AIRLIGHT_TAIL ? airlight_tail_texels[y * AIRLIGHT_TAIL_NX + x]
+                                            : surface_glow_texels[y * SURFACE_GLOW_NX + x];
+    }
     int point_light_count() const { return frame.film_counts.z; }
     PointLightGpu point_light(int i) const { return point_lights[i]; }
     int surface_count() const { return frame.film_counts.w; }
@@ -26,11 +32,18 @@ struct CpuShader {
 #define HAS_MEDIUM (features.medium)
 #define HAS_POINT_LIGHTS (features.point_lights)
 #define HAS_SURFACES (features.surfaces)
+#define HAS_AIRLIGHT (features.airlight)
+#define AIRLIGHT_MARCH (features.airlight_march)
+#define GREY_MEDIUM (features.grey_medium)
 #include "geometry.glsl"
+#include "airlight.glsl"
 #include "shading.glsl"
 #undef HAS_MEDIUM
 #undef HAS_POINT_LIGHTS
 #undef HAS_SURFACES
+#undef HAS_AIRLIGHT
+#undef AIRLIGHT_MARCH
+#undef GREY_MEDIUM
 };
 
 }  // namespace shader
@@ -42,7 +55,12 @@ void CpuBackend::render(const FrameData& data, Image& out) {
     out.height = height;
     out.rgb.assign(size_t(width) * size_t(height) * 3, 0.0f);
 
-    const shader::CpuShader program{data.frame, data.point_lights.data(), data.surfaces.data(), data.features};
+    const shader::CpuShader program{data.frame,
+                                    data.point_lights.data(),
+                                    data.surfaces.data(),
+                                    data.airlight_tail ? data.airlight_tail->texels.data() : nullptr,
+                                    data.surface_glow ? data.surface_glow->texels.data() : nullptr,
+                                    data.features};
     std::atomic<int> next_row{0};
     auto worker = [&]() {
         shader::CpuShader local = program;

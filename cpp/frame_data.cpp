@@ -1,6 +1,11 @@
+#define GLM_ENABLE_EXPERIMENTAL
 #include "frame_data.hpp"
 
+#include <glm/gtx/component_wise.hpp>
+
+#include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace airlight {
 
@@ -21,15 +26,49 @@ FrameData make_frame_data(const Scene& scene) {
     f.camera_forward = glm::vec4(forward, 0.0f);
 
     const bool medium = scene.has_medium && glm::any(glm::greaterThan(scene.medium.sigma_t, glm::vec3(0.0f)));
-    if (medium) {
-        f.sigma_t = glm::vec4(scene.medium.sigma_t, 0.0f);
-        f.sigma_s = glm::vec4(scene.medium.sigma_s(), 0.0f);
-    }
+    const glm::vec3 sigma_t = medium ? scene.medium.sigma_t : glm::vec3(0.0f);
+    const glm::vec3 sigma_s = medium ? scene.medium.sigma_s() : glm::vec3(0.0f);
+    const bool scattering = glm::any(glm::greaterThan(sigma_s, glm::vec3(0.0f)));
+    f.sigma_t = glm::vec4(sigma_t, 0.0f);
+    f.sigma_s = glm::vec4(sigma_s, 0.0f);
     f.background = glm::vec4(scene.background, 0.0f);
 
+    // Culling (docs/culling.md). Reference radiance: the brightest of, over
+    // lights, the glow 1 m from the lamp in its own fog (sigma_s I / 4) and a
+    // white surface 5 m from it (I / (25 pi)). A light's largest possible
+    // radiance anywhere in the frame is bounded by e^{-sigma_t (D - r)} I times
+    // the largest of its core (1 / (pi r^2)), its airlight (sigma_s / (4 r)) and
+    // its surface glow (sigma_s G(0, 0) / (2 pi^2 r)), because every path from
+    // the light to the camera is at least D - r long.
+    float reference = 0.0f;
     for (const PointLight& light : scene.point_lights) {
+        const glm::vec3 white = light.intensity * glm::max(sigma_s * 0.25f, glm::vec3(1.0f / (25.0f * shader::PI)));
+        reference = std::max(reference, glm::compMax(white));
+    }
+    const float cull_radiance = scene.quality.cull_fraction * reference;
+    const float glow_max = scattering && !scene.point_lights.empty() ? surface_glow_table().texels[0] : 0.0f;  // G(0, 0) is the largest
+    const float min_sigma_t = glm::compMin(sigma_t);
+    float farthest = 0.0f;
+    for (const PointLight& light : scene.point_lights) {
+        const float r = light.radius;
+        const float dist = glm::length(light.position - cam.position);
+        const float per_intensity = std::max({1.0f / (shader::PI * r * r), glm::compMax(sigma_s) / (4.0f * r),
+                                              glm::compMax(sigma_s) * glow_max / (2.0f * shader::PI * shader::PI * r)});
+        const float bound = glm::compMax(light.intensity) * per_intensity * std::exp(-min_sigma_t * std::max(dist - r, 0.0f));
+        if (bound < cull_radiance) {
+            ++data.lights_culled;
+            continue;
+        }
+        farthest = std::max(farthest, dist);
         data.point_lights.push_back({glm::vec4(light.position, light.radius), glm::vec4(light.intensity, 0.0f)});
     }
+    // Ray marching (benchmarks): escaping rays are cut where the transmittance
+    // of the thinnest scattering channel has fallen below e^{-16}.
+    float thinnest = std::numeric_limits<float>::infinity();
+    for (int c = 0; c < 3; ++c)
+        if (sigma_s[c] > 0.0f) thinnest = std::min(thinnest, sigma_t[c]);
+    const float march_far = scattering ? farthest + 16.0f / thinnest : 0.0f;
+    f.quality = glm::vec4(cull_radiance, float(scene.quality.march_steps), march_far, 0.0f);
     for (const Surface& s : scene.surfaces) {
         shader::SurfaceGpu g{};
         switch (s.type) {
@@ -57,6 +96,14 @@ FrameData make_frame_data(const Scene& scene) {
     data.features.medium = medium;
     data.features.point_lights = !data.point_lights.empty();
     data.features.surfaces = !data.surfaces.empty();
+    data.features.airlight = scattering && !data.point_lights.empty();
+    data.features.airlight_march = data.features.airlight && scene.quality.airlight == AirlightMethod::march;
+    data.features.grey_medium = sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z && sigma_s.x == sigma_s.y &&
+                                sigma_s.y == sigma_s.z;
+    if (data.features.airlight) {
+        data.surface_glow = &surface_glow_table();
+        if (!data.features.airlight_march) data.airlight_tail = &airlight_tail_table();
+    }
     return data;
 }
 

@@ -3,6 +3,7 @@
 
 #include "airlight/scene.hpp"
 #include "shader_cpp.hpp"
+#include "tables.hpp"
 
 #include <vector>
 
@@ -13,10 +14,17 @@ struct FrameData {
     std::vector<shader::PointLightGpu> point_lights;
     std::vector<shader::SurfaceGpu> surfaces;
     shader::Features features;
+    // Tables the shader variant reads (null when the scene does not need them:
+    // they are then never built).
+    const Table2D* airlight_tail = nullptr;
+    const Table2D* surface_glow = nullptr;
+    int lights_culled = 0;  // point lights dropped for the whole frame (docs/culling.md)
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and
-// surfaces, and the feature set that selects the shader variant.
+// surfaces, the feature set that selects the shader variant, and the tables
+// that variant needs. Lights whose contribution to every pixel is provably
+// below the cull radiance are dropped here.
 FrameData make_frame_data(const Scene& scene);
 
 }  // namespace airlight

@@ -180,7 +180,11 @@ std::string fragment_shader_source(const shader::Features& features) {
     source += std::string("#define HAS_MEDIUM ") + (features.medium ? "true" : "false") + "\n";
     source += std::string("#define HAS_POINT_LIGHTS ") + (features.point_lights ? "true" : "false") + "\n";
     source += std::string("#define HAS_SURFACES ") + (features.surfaces ? "true" : "false") + "\n";
-    for (const char* name : {"layout.glsl", "resources.glsl", "geometry.glsl", "shading.glsl", "render.frag"}) {
+    source += std::string("#define HAS_AIRLIGHT ") + (features.airlight ? "true" : "false") + "\n";
+    source += std::string("#define AIRLIGHT_MARCH ") + (features.airlight_march ? "true" : "false") + "\n";
+    source += std::string("#define GREY_MEDIUM ") + (features.grey_medium ? "true" : "false") + "\n";
+    for (const char* name : {"constants.glsl", "layout.glsl", "resources.glsl", "geometry.glsl", "airlight.glsl",
+                             "shading.glsl", "render.frag"}) {
         source += "// ---- " + std::string(name) + "\n";
         source += shader_source(name);
     }
@@ -194,6 +198,21 @@ struct GlBackend::State {
     GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0;
     size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0;
     int fbo_width = 0, fbo_height = 0;
+    std::map<const Table2D*, GLuint> table_textures;  // uploaded once per context
+
+    // The texture holding `table`, uploaded on first use.
+    GLuint texture_for(const Table2D& table) {
+        auto it = table_textures.find(&table);
+        if (it != table_textures.end()) return it->second;
+        GLuint tex = 0;
+        glCreateTextures(GL_TEXTURE_2D, 1, &tex);
+        glTextureStorage2D(tex, 1, GL_R32F, table.width, table.height);
+        glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
+        glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
+        glTextureSubImage2D(tex, 0, 0, 0, table.width, table.height, GL_RED, GL_FLOAT, table.texels.data());
+        table_textures[&table] = tex;
+        return tex;
+    }
 
     void make_current() {
         if (!eglMakeCurrent(egl.display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl.context)) {
@@ -248,6 +267,7 @@ GlBackend::~GlBackend() {
     if (state_->egl.context != EGL_NO_CONTEXT) {
         state_->make_current();
         for (auto& entry : state_->programs) glDeleteProgram(entry.second);
+        for (auto& entry : state_->table_textures) glDeleteTextures(1, &entry.second);
         glDeleteTextures(1, &state_->color);
         glDeleteFramebuffers(1, &state_->fbo);
         glDeleteVertexArrays(1, &state_->vao);
@@ -280,6 +300,9 @@ void GlBackend::render(const FrameData& data, Image& out) {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, s.frame_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.light_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.surface_ssbo);
+
+    if (data.airlight_tail) glBindTextureUnit(0, s.texture_for(*data.airlight_tail));
+    if (data.surface_glow) glBindTextureUnit(1, s.texture_for(*data.surface_glow));
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glViewport(0, 0, width, height);

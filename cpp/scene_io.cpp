@@ -39,6 +39,7 @@ using NameTable = std::vector<std::pair<const char*, E>>;
 
 const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic}};
 const NameTable<LightType> light_types{{"point", LightType::point}};
+const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic}, {"march", AirlightMethod::march}};
 const NameTable<SurfaceType> surface_types{
     {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
 
@@ -365,12 +366,25 @@ json json_vec3(const glm::vec3& v) {
     return json::array({json_number(v.x), json_number(v.y), json_number(v.z)});
 }
 
+Quality parse_quality(const Obj& o) {
+    o.check_keys({"airlight", "march_steps", "cull_fraction"});
+    Quality q;
+    if (auto v = o.opt("airlight")) q.airlight = read_enum(*v, "airlight", airlight_methods);
+    if (auto v = o.opt("march_steps")) q.march_steps = read_int(*v, 1, 65536);
+    if (auto v = o.opt("cull_fraction")) {
+        double x = read_number(*v);
+        if (x < 0 || x > 0.01) fail(Kind::value, v->field, "must be in [0, 0.01]");
+        q.cull_fraction = static_cast<float>(x);
+    }
+    return q;
+}
+
 }  // namespace
 
 Scene parse_scene_json(const json& j) {
     if (!j.is_object()) fail(Kind::type, "", "scene must be a JSON object");
     Obj top(Value{j, ""});
-    top.check_keys({"film", "camera", "medium", "lights", "surfaces", "background"});
+    top.check_keys({"film", "camera", "medium", "lights", "surfaces", "background", "quality"});
     Scene s;
     s.film = parse_film(Obj(top.req("film")));
     s.camera = parse_camera(Obj(top.req("camera")));
@@ -381,6 +395,7 @@ Scene parse_scene_json(const json& j) {
     s.point_lights = read_list<PointLight>(top.opt("lights"), parse_light);
     s.surfaces = read_list<Surface>(top.opt("surfaces"), parse_surface);
     if (auto v = top.opt("background")) s.background = read_rgb(*v);
+    if (auto v = top.opt("quality")) s.quality = parse_quality(Obj(*v));
     return s;
 }
 
@@ -425,6 +440,9 @@ json scene_to_json_value(const Scene& s) {
         j["surfaces"].push_back(std::move(o));
     }
     j["background"] = json_vec3(s.background);
+    j["quality"] = {{"airlight", name_of(airlight_methods, s.quality.airlight)},
+                    {"march_steps", s.quality.march_steps},
+                    {"cull_fraction", json_number(s.quality.cull_fraction)}};
     return j;
 }
 

@@ -14,6 +14,7 @@ using namespace glm;
 #define OUT(T) T&
 #define INOUT(T) T&
 
+#include "constants.glsl"
 #include "layout.glsl"
 
 // Which optional features a scene uses; a GL shader variant is compiled per
@@ -22,8 +23,14 @@ struct Features {
     bool medium = false;
     bool point_lights = false;
     bool surfaces = false;
+    bool airlight = false;      // point lights in a scattering medium: airlight and surface glow
+    bool airlight_march = false;  // brute-force ray marching instead of the tables (benchmarks)
+    bool grey_medium = false;   // sigma_t and sigma_s equal on all channels: one evaluation, not three
 
-    int key() const { return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0); }
+    int key() const {
+        return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |
+               (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0);
+    }
 };
 
 }  // namespace airlight::shader

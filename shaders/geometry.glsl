@@ -2,9 +2,6 @@
 // intersections. Requires the accessors frame, surface_count(), surface(i),
 // point_light_count(), point_light(i) (declared per backend).
 
-CONST float PI = 3.14159265358979f;
-CONST float NO_HIT = 3.0e38f;  // "infinitely far" distance along a ray
-
 // Unit direction of the ray through the centre of pixel (x, row), row 0 on top.
 vec3 camera_ray_direction(int x, int row) {
     float width = float(frame.film_counts.x);

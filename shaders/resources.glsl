@@ -8,3 +8,13 @@ int point_light_count() { return frame.film_counts.z; }
 PointLightGpu point_light(int i) { return point_lights[i]; }
 int surface_count() { return frame.film_counts.w; }
 SurfaceGpu surface(int i) { return surfaces[i]; }
+
+// Scattering tables (cpp/tables.cpp), read texel by texel: the shared code
+// interpolates them itself so that GPU and CPU results agree exactly.
+layout(binding = 0) uniform sampler2D airlight_tail_texels;
+layout(binding = 1) uniform sampler2D surface_glow_texels;
+
+float table_texel(int table, int x, int y) {
+    if (table == TABLE_AIRLIGHT_TAIL) return texelFetch(airlight_tail_texels, ivec2(x, y), 0).r;
+    return texelFetch(surface_glow_texels, ivec2(x, y), 0).r;
+}

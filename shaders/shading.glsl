@@ -1,6 +1,7 @@
 // Radiance along camera rays, shared by both backends. Feature switches
-// (HAS_MEDIUM, HAS_POINT_LIGHTS, HAS_SURFACES) are compile-time constants in
-// a GL shader variant and cheap runtime flags on the CPU.
+// (HAS_MEDIUM, HAS_POINT_LIGHTS, HAS_SURFACES, HAS_AIRLIGHT, AIRLIGHT_MARCH,
+// GREY_MEDIUM) are compile-time constants in a GL shader variant and cheap
+// runtime flags on the CPU.
 
 // Beer-Lambert transmittance exp(-sigma_t t) of the homogeneous medium.
 // t = NO_HIT (escaping ray) gives 0 on every channel with sigma_t > 0.
@@ -15,10 +16,26 @@ float surface_offset(vec3 p) {
     return 1.0e-4f * (1.0f + max(max(abs(p.x), abs(p.y)), abs(p.z)));
 }
 
+// Light scattered once on its way from a lamp to a surface point at distance
+// dist, per unit intensity: sigma_s / (2 pi D) e^{-T} G(T, theta_s)
+// (MODELS.md section 1, G0 term), D held at the lamp radius inside the lamp.
+vec3 surface_glow_per_intensity(float dist, float radius, float cos_theta_s) {
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 glow;
+    if (GREY_MEDIUM) {
+        glow = vec3(surface_glow(sigma_t.x * dist, cos_theta_s));
+    } else {
+        glow = vec3(surface_glow(sigma_t.x * dist, cos_theta_s), surface_glow(sigma_t.y * dist, cos_theta_s),
+                    surface_glow(sigma_t.z * dist, cos_theta_s));
+    }
+    return vec3(frame.sigma_s) * glow / (2.0f * PI * max(dist, radius));
+}
+
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
 // lamps: inverse-square falloff, Lambert's cosine, attenuation exp(-sigma_t d)
-// along the lamp-to-point path and hard shadows from every surface. Inside a
-// lamp's radius the falloff is held at its value on the lamp's sphere.
+// along the lamp-to-point path and hard shadows from every surface; plus, in
+// a scattering medium, the light scattered once on the way (not shadowed).
+// Inside a lamp's radius the falloff is held at its value on the lamp's sphere.
 vec3 point_light_irradiance(vec3 p, vec3 n) {
     vec3 irradiance = vec3(0.0f);
     vec3 shadow_origin = p + surface_offset(p) * n;
@@ -31,12 +48,56 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         if (dist <= 0.0f) continue;
         vec3 l = to_light / dist;
         float cos_theta = dot(n, l);
+        if (HAS_AIRLIGHT) irradiance += vec3(light.intensity) * surface_glow_per_intensity(dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
         irradiance += vec3(light.intensity) * (cos_theta / max(dist2, radius * radius)) *
                       transmittance(dist);
     }
     return irradiance;
+}
+
+// Brute-force airlight of one light on [x0, x1]: the midpoint rule with
+// frame.quality.y steps on the defining integral of MODELS.md section 1,
+// escaping rays cut at frame.quality.z metres. For benchmarks only.
+vec3 airlight_march(vec3 light_position, vec3 intensity, vec3 origin, vec3 dir, float x0, float x1) {
+    float x_end = min(x1, frame.quality.z);
+    int steps = int(frame.quality.y);
+    float dx = (x_end - x0) / float(steps);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 sum = vec3(0.0f);
+    for (int k = 0; k < steps; ++k) {
+        float x = x0 + (float(k) + 0.5f) * dx;
+        vec3 to_light = light_position - (origin + x * dir);
+        float d2 = dot(to_light, to_light);
+        sum += exp(-sigma_t * (x + sqrt(d2))) / d2;
+    }
+    return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
+}
+
+// Airlight of point light `light` over the visible part [0, x_end] of the
+// view ray (MODELS.md section 1): sigma_s I / (2 pi h) times the segment
+// integral of airlight.glsl. A camera inside the lamp's sphere sees fog from
+// where the ray leaves the sphere. Skipped where the bound
+// sigma_s I e^{-sigma_t D} (pi / 2) / (2 pi h) is below frame.quality.x.
+vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_end) {
+    vec3 to_light = vec3(light.position_radius) - origin;
+    float radius = light.position_radius.w;
+    float dist = length(to_light);
+    float b = dot(to_light, dir);
+    float h = max(length(to_light - b * dir), 1.0e-6f * max(dist, radius));
+    float x0 = 0.0f;
+    if (dist < radius) x0 = b + sqrt(max(radius * radius - h * h, 0.0f));
+    if (x0 >= x_end) return vec3(0.0f);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
+    float min_sigma_t = min(min(sigma_t.x, sigma_t.y), sigma_t.z);
+    float bound = max(max(scale.x, scale.y), scale.z) * (0.5f * PI) * exp(-min_sigma_t * max(dist - radius, 0.0f));
+    if (bound < frame.quality.x) return vec3(0.0f);
+    if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), origin, dir, x0, x_end);
+    if (GREY_MEDIUM) return scale * airlight_segment(sigma_t.x, b, h, x0, x_end);
+    return scale * vec3(airlight_segment(sigma_t.x, b, h, x0, x_end), airlight_segment(sigma_t.y, b, h, x0, x_end),
+                        airlight_segment(sigma_t.z, b, h, x0, x_end));
 }
 
 // Radiance arriving at the camera along the ray origin + t dir.
@@ -72,8 +133,13 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     } else {
         radiance = vec3(frame.background);
     }
-    // Everything behind the medium reaches the camera attenuated.
-    return radiance * transmittance(t_hit);
+    // Everything behind the medium reaches the camera attenuated; the fog in
+    // front of it adds its glow.
+    radiance *= transmittance(t_hit);
+    if (HAS_AIRLIGHT) {
+        for (int i = 0; i < point_light_count(); ++i) radiance += point_light_airlight(point_light(i), origin, dir, t_hit);
+    }
+    return radiance;
 }
 
 // Linear radiance of pixel (x, row), row 0 on top: the per-pixel entry point.

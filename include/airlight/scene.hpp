@@ -68,6 +68,22 @@ struct Surface {
     Rgb albedo{0.5f};
 };
 
+// How the airlight is computed (MODELS.md section 1).
+enum class AirlightMethod {
+    analytic,  // the table method: exact up to the tables' measured error
+    march,     // brute-force ray marching, for benchmarks and comparison
+};
+
+// Accuracy and speed settings (the "quality" object of the scene format).
+struct Quality {
+    AirlightMethod airlight = AirlightMethod::analytic;
+    int march_steps = 64;  // midpoint-rule steps per light and view ray, for "march"
+    // A light is skipped wherever a bound proves its contribution to a pixel
+    // below cull_fraction x the scene's reference radiance (docs/culling.md);
+    // 0 disables culling.
+    float cull_fraction = 1e-5f;
+};
+
 struct Scene {
     Film film;
     Camera camera;
@@ -76,6 +92,7 @@ struct Scene {
     std::vector<PointLight> point_lights;
     std::vector<Surface> surfaces;
     Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium)
+    Quality quality;
 };
 
 }  // namespace airlight

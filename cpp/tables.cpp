@@ -1,0 +1,164 @@
+#include "tables.hpp"
+
+#include "shader_cpp.hpp"
+
+#include <atomic>
+#include <chrono>
+#include <cmath>
+#include <complex>
+#include <mutex>
+#include <vector>
+
+namespace airlight {
+namespace {
+
+using cdouble = std::complex<double>;
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kEulerGamma = 0.57721566490153286061;
+
+std::atomic<int> built_count{0};
+
+// e^w E1(w) for Re w >= 0: power series for |w| < 3.5, else the even
+// continued fraction e^w E1(w) = 1 / (w + 1 - 1^2 / (w + 3 - 2^2 / (w + 5 - ...))).
+// Both agree with scipy's exp1 to < 2e-12 over the quarter plane we use.
+cdouble scaled_e1(cdouble w) {
+    if (std::abs(w) < 3.5) {
+        cdouble sum = 0.0, term = 1.0;
+        for (int k = 1; k < 80; ++k) {
+            term *= -w / double(k);
+            sum += term / double(k);
+        }
+        return std::exp(w) * (-kEulerGamma - std::log(w) - sum);
+    }
+    cdouble f = 0.0;
+    for (int k = 120; k >= 1; --k) f = double(k) * double(k) / (w + double(2 * k + 1) - f);
+    return 1.0 / (w + 1.0 - f);
+}
+
+// Composite Gauss-Legendre (8 points per panel) nodes and weights.
+const double kGl8x[8] = {-0.9602898564975363, -0.7966664774136267, -0.5255324099163290, -0.1834346424956498,
+                         0.1834346424956498,  0.5255324099163290,  0.7966664774136267,  0.9602898564975363};
+const double kGl8w[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873, 0.3626837833783620,
+                         0.3626837833783620, 0.3137066458778873, 0.2223810344533745, 0.1012285362903763};
+
+// Azimuthal integral of max(cos theta_s cos g + sin theta_s sin g cos phi, 0)
+// over phi in [0, 2 pi): the clamped cosine of directions at angle g from the
+// light direction, seen from a surface whose normal is at theta_s from it.
+double clamped_cosine_ring(double g, double theta_s) {
+    const double a = std::cos(theta_s) * std::cos(g);
+    const double b = std::sin(theta_s) * std::sin(g);
+    if (b <= std::abs(a)) return a > 0.0 ? 2.0 * kPi * a : 0.0;
+    const double phi0 = std::acos(-a / b);
+    return 2.0 * (a * phi0 + b * std::sin(phi0));
+}
+
+template <class Build>
+Table2D timed_build(Build build) {
+    const auto start = std::chrono::steady_clock::now();
+    Table2D table = build();
+    table.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    ++built_count;
+    return table;
+}
+
+// Quadrature nodes in g in [0, pi] for the glow integral: panels graded
+// geometrically towards g = 0, where Q(T sin g, g/2) has a boundary layer of
+// width ~1/T, then uniform. Returns (g, weight) pairs.
+std::vector<std::pair<double, double>> glow_nodes(int scale) {
+    std::vector<double> edges = {0.0};
+    for (double e = 1e-5; e < 0.5; e *= 1.0 + 0.6 / scale) edges.push_back(e);
+    const int uniform_panels = 24 * scale;
+    const double start = edges.back();
+    for (int i = 1; i <= uniform_panels; ++i) edges.push_back(start + (kPi - start) * i / uniform_panels);
+    std::vector<std::pair<double, double>> nodes;
+    for (size_t p = 0; p + 1 < edges.size(); ++p) {
+        const double mid = 0.5 * (edges[p] + edges[p + 1]), half = 0.5 * (edges[p + 1] - edges[p]);
+        for (int k = 0; k < 8; ++k) nodes.emplace_back(mid + half * kGl8x[k], half * kGl8w[k]);
+    }
+    return nodes;
+}
+
+}  // namespace
+
+double airlight_tail_exact(double u, double cv) {
+    if (cv <= 0.0) return 0.0;
+    if (u <= 0.0) return cv;
+    const cdouble w(u * std::cos(cv) / std::sin(cv), -u);
+    return scaled_e1(w).imag();
+}
+
+double surface_glow_exact(double optical_distance, double theta_s, int nodes_scale) {
+    double sum = 0.0;
+    for (const auto& [g, w] : glow_nodes(nodes_scale)) {
+        const double ring = clamped_cosine_ring(g, theta_s);
+        if (ring == 0.0) continue;
+        sum += w * ring * airlight_tail_exact(optical_distance * std::sin(g), 0.5 * (kPi - g));
+    }
+    return sum;
+}
+
+const Table2D& airlight_tail_table() {
+    static const Table2D table = timed_build([] {
+        using namespace shader;
+        Table2D t;
+        t.width = AIRLIGHT_TAIL_NX;
+        t.height = AIRLIGHT_TAIL_NY;
+        t.texels.resize(size_t(t.width) * t.height);
+        for (int iy = 0; iy < t.height; ++iy) {
+            const double cv = (1.0 - double(iy) / (t.height - 1)) * 0.5 * kPi;
+            for (int ix = 0; ix < t.width; ++ix) {
+                const double X = double(ix) / (t.width - 1);
+                double S = 1.0;  // exact at u = 0 (X = 0) and u = infinity (X = 1)
+                if (ix > 0 && ix + 1 < t.width) {
+                    const double r = X * X, z = r / (1.0 - r);
+                    if (iy + 1 == t.height) {
+                        // xi = pi/2 at fixed z = u sec xi: S = (1 - z e^z E1(z)) (1 + z).
+                        S = (1.0 - z * scaled_e1(cdouble(z, 0.0)).real()) * (1.0 + z);
+                    } else {
+                        const double s = std::sin(cv), u = z * s;
+                        const double N = cv / (1.0 + u * cv / (s * s));
+                        S = airlight_tail_exact(u, cv) / N;
+                    }
+                }
+                t.texels[size_t(iy) * t.width + ix] = float(S);
+            }
+        }
+        return t;
+    });
+    return table;
+}
+
+const Table2D& surface_glow_table() {
+    static const Table2D table = timed_build([] {
+        using namespace shader;
+        Table2D t;
+        t.width = SURFACE_GLOW_NX;
+        t.height = SURFACE_GLOW_NY;
+        t.texels.resize(size_t(t.width) * t.height);
+        const auto nodes = glow_nodes(1);
+        std::vector<double> q(nodes.size());
+        for (int ix = 0; ix < t.width; ++ix) {
+            const double X = double(ix) / (t.width - 1);
+            const double T = X * X * double(SURFACE_GLOW_T_MAX);
+            // Q depends on T and g only: evaluate once per column, reuse for every theta_s.
+            for (size_t n = 0; n < nodes.size(); ++n) {
+                const double g = nodes[n].first;
+                q[n] = airlight_tail_exact(T * std::sin(g), 0.5 * (kPi - g));
+            }
+            for (int iy = 0; iy < t.height; ++iy) {
+                const double theta_s = kPi * iy / (t.height - 1);
+                double sum = 0.0;
+                for (size_t n = 0; n < nodes.size(); ++n) {
+                    sum += nodes[n].second * q[n] * clamped_cosine_ring(nodes[n].first, theta_s);
+                }
+                t.texels[size_t(iy) * t.width + ix] = float(sum);
+            }
+        }
+        return t;
+    });
+    return table;
+}
+
+int tables_built() { return built_count.load(); }
+
+}  // namespace airlight

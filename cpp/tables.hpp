@@ -1,0 +1,38 @@
+// The scattering tables: built once per process from exact double-precision
+// evaluations and shared, texel for texel, by both backends. Their
+// parametrisations, resolutions and measured errors: docs/airlight_table.md.
+#pragma once
+
+#include <vector>
+
+namespace airlight {
+
+// A grid of float32 texels, row-major: texels[y * width + x]; node-aligned
+// (texel i sits at the normalised coordinate i / (width - 1)).
+struct Table2D {
+    int width = 0;
+    int height = 0;
+    std::vector<float> texels;
+    double build_seconds = 0.0;
+};
+
+// Exact normalised airlight tail (MODELS.md section 1, docs/airlight_table.md)
+//   Q(u, v) = e^{u tan v} int_v^{pi/2} e^{-u tan t} dt,   cv = pi/2 - v,
+// through the complex exponential integral: Q = Im[e^w E1(w)], w = u (tan v - i).
+double airlight_tail_exact(double u, double cv);
+
+// Exact surface glow G(T, theta_s) = e^T G0(T, theta_s) (MODELS.md section 1):
+//   G = int_0^pi Q(T sin g, g / 2) Phi(g, theta_s) dg,
+// Phi the azimuthal integral of the clamped cosine. `nodes_scale` > 1 refines
+// the quadrature (tests use it to check convergence).
+double surface_glow_exact(double optical_distance, double theta_s, int nodes_scale = 1);
+
+// The tables, built on first use (thread safe) and kept for the process.
+const Table2D& airlight_tail_table();
+const Table2D& surface_glow_table();
+
+// Number of tables built so far in this process (for tests showing that a
+// scene which does not need them builds none).
+int tables_built();
+
+}  // namespace airlight

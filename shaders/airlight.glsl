@@ -1,0 +1,76 @@
+// Airlight of isotropic point lights in a homogeneous medium (MODELS.md
+// section 1, Sun et al. 2005) and the light they scatter onto surfaces, by
+// table lookups. The tables, their parametrisation and their measured errors
+// are explained in docs/airlight_table.md; cpp/tables.cpp builds them from
+// these same coordinate definitions. Requires table_texel(table, x, y).
+
+// Manual bilinear interpolation on a node-aligned grid (texel i at
+// X = i / (n - 1)): exact float32 arithmetic, identical on GPU and CPU (GL's
+// fixed-point texture filtering would not be).
+float table_bilinear(int table, int nx, int ny, float X, float Y) {
+    float fx = clamp(X, 0.0f, 1.0f) * float(nx - 1);
+    float fy = clamp(Y, 0.0f, 1.0f) * float(ny - 1);
+    int ix = min(int(fx), nx - 2);
+    int iy = min(int(fy), ny - 2);
+    float ax = fx - float(ix);
+    float ay = fy - float(iy);
+    float bottom = mix(table_texel(table, ix, iy), table_texel(table, ix + 1, iy), ax);
+    float top = mix(table_texel(table, ix, iy + 1), table_texel(table, ix + 1, iy + 1), ax);
+    return mix(bottom, top, ay);
+}
+
+// ---- Airlight along a view ray -------------------------------------------
+// Geometry of one light relative to the ray o + x d: b = (S - o).d is the
+// distance along the ray to the closest approach, h > 0 the closest distance.
+
+// exp(-sigma (x + d(x))) Q(u, xi(x)): the airlight integral from ray point x
+// to infinity in units of sigma_s I / (2 pi h), with d(x) the point-light
+// distance and xi(x) = 1/2 atan2(h, b - x) (MODELS.md section 1). Every factor
+// is <= 1, so nothing overflows however thick the fog.
+float airlight_tail(float sigma, float b, float h, float x) {
+    float xb = x - b;
+    float d = sqrt(h * h + xb * xb);
+    float p = xb >= 0.0f ? d + xb : h * h / (d - xb);  // d + x - b, no cancellation
+    float tan_xi = p / h;
+    float cv = 0.5f * atan(h, xb);                       // pi/2 - xi, accurate near pi/2
+    float z = sigma * sqrt(2.0f * d * p);                // u sec xi
+    float S = table_bilinear(TABLE_AIRLIGHT_TAIL, AIRLIGHT_TAIL_NX, AIRLIGHT_TAIL_NY, sqrt(z / (1.0f + z)),
+                             1.0f - cv * (2.0f / PI));
+    float N = cv / (1.0f + 2.0f * sigma * d * tan_xi * cv);  // u sec^2 xi = 2 sigma d tan xi
+    return exp(-sigma * (x + d)) * N * S;
+}
+
+// Airlight integral over the ray segment [x0, x1] (x1 = NO_HIT: to infinity)
+// in units of sigma_s I / (2 pi h): the difference of two tails, or, when
+// that difference would cancel (tail(x1) > tail(x0) / 2), 3-point
+// Gauss-Legendre of the integrand exp(-u (tan xi - tan xi0)) in xi.
+float airlight_segment(float sigma, float b, float h, float x0, float x1) {
+    float tail0 = airlight_tail(sigma, b, h, x0);
+    if (x1 >= NO_HIT) return tail0;
+    float tail1 = airlight_tail(sigma, b, h, x1);
+    if (tail1 <= 0.5f * tail0) return tail0 - tail1;
+    float xb0 = x0 - b;
+    float cv0 = 0.5f * atan(h, xb0);
+    float dv = 0.5f * atan(h * (x1 - x0), h * h + xb0 * (x1 - b));  // xi(x1) - xi(x0)
+    float u = sigma * h;
+    float s0 = sin(cv0);
+    // tan(xi0 + e) - tan(xi0) = sin e / (sin cv0 sin(cv0 - e)); nodes at (1 +- sqrt(3/5)) / 2.
+    float e0 = dv * 0.11270166537925831f;
+    float e1 = dv * 0.5f;
+    float e2 = dv * 0.88729833462074169f;
+    float sum = (5.0f / 18.0f) * exp(-u * sin(e0) / (s0 * sin(cv0 - e0))) +
+                (8.0f / 18.0f) * exp(-u * sin(e1) / (s0 * sin(cv0 - e1))) +
+                (5.0f / 18.0f) * exp(-u * sin(e2) / (s0 * sin(cv0 - e2)));
+    float d0 = sqrt(h * h + xb0 * xb0);
+    return exp(-sigma * (x0 + d0)) * sum * dv;
+}
+
+// ---- Light scattered onto surfaces ----------------------------------------
+// G(T, theta_s) = e^{T} G0(T, theta_s); the irradiance from light scattered
+// once on the way is sigma_s I / (2 pi D) e^{-T} G (MODELS.md section 1).
+float surface_glow(float optical_distance, float cos_theta_s) {
+    if (optical_distance >= SURFACE_GLOW_T_MAX) return 0.0f;
+    float theta_s = acos(clamp(cos_theta_s, -1.0f, 1.0f));
+    return exp(-optical_distance) * table_bilinear(TABLE_SURFACE_GLOW, SURFACE_GLOW_NX, SURFACE_GLOW_NY,
+                                                   sqrt(optical_distance / SURFACE_GLOW_T_MAX), theta_s / PI);
+}

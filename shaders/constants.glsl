@@ -1,0 +1,24 @@
+// Constants shared by every shader file, the table builder (cpp/tables.cpp)
+// and the CPU backend.
+
+CONST float PI = 3.14159265358979f;
+CONST float NO_HIT = 3.0e38f;  // "infinitely far" distance along a ray
+
+// ---- Tables -------------------------------------------------------------
+// Normalised airlight tail S(X, Y) (docs/airlight_table.md):
+//   Q(u, xi) = e^{u tan xi} int_xi^{pi/2} e^{-u tan t} dt = N(u, xi) S(X, Y),
+//   N = cv / (1 + u sec^2(xi) cv),  cv = pi/2 - xi,
+//   X = sqrt(z / (1 + z)), z = u sec xi,   Y = xi / (pi/2).
+// X in [0, 1] covers every u >= 0, so no range is left outside the table.
+CONST int TABLE_AIRLIGHT_TAIL = 0;
+CONST int AIRLIGHT_TAIL_NX = 256;
+CONST int AIRLIGHT_TAIL_NY = 64;
+
+// Surface glow G(T, theta_s) = e^{T} G0(T, theta_s) (MODELS.md section 1,
+// "surfaces lit through fog"), X = sqrt(T / T_max), Y = theta_s / pi. Beyond
+// T_max the factor e^{-T} < 1e-43 makes the glow exactly 0 in float32.
+CONST int TABLE_SURFACE_GLOW = 1;
+CONST int SURFACE_GLOW_NX = 96;
+CONST int SURFACE_GLOW_NY = 48;
+CONST float SURFACE_GLOW_T_MAX = 100.0f;
+

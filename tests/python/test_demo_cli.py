@@ -1,0 +1,184 @@
+"""The airlight-demo command line: success writes the file; every failure exits
+non-zero with exactly one line on stderr that says what is wrong."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+from PIL import Image
+
+DEMO = Path(sys.executable).with_name("airlight-demo")
+
+
+def _demo(*args: str) -> subprocess.CompletedProcess:
+    if not DEMO.exists():
+        pytest.skip(f"{DEMO} is not installed")
+    return subprocess.run([str(DEMO), *args], capture_output=True, text=True, timeout=60)
+
+
+def _assert_one_line_error(proc: subprocess.CompletedProcess, *needles: str) -> str:
+    assert proc.returncode != 0, f"exit 0; stdout {proc.stdout!r}"
+    lines = proc.stderr.splitlines()
+    assert len(lines) == 1, f"expected exactly one line on stderr, got {proc.stderr!r}"
+    for needle in needles:
+        assert needle in lines[0], f"{needle!r} not in {lines[0]!r}"
+    return lines[0]
+
+
+@pytest.fixture
+def scene_file(tmp_path: Path, scene_factory) -> Path:
+    path = tmp_path / "scene.json"
+    path.write_text(json.dumps(scene_factory()))
+    return path
+
+
+def _write_scene(tmp_path: Path, scene: dict) -> Path:
+    path = tmp_path / "bad.json"
+    path.write_text(json.dumps(scene))
+    return path
+
+
+@pytest.mark.parametrize("ext", ["png", "pfm"])
+def test_demo_exits_zero_and_writes_the_file(
+        tmp_path: Path, scene_file: Path, backend: str, ext: str) -> None:
+    out = tmp_path / f"x.{ext}"
+    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", backend, "--width", "40",
+                 "--height", "30")
+    assert proc.returncode == 0, proc.stderr
+    assert out.is_file() and out.stat().st_size > 0
+    assert proc.stderr == "", "a successful run with an explicit backend prints nothing on stderr"
+    assert backend in proc.stdout
+
+
+def test_demo_uses_the_scene_film_size_without_overrides(tmp_path: Path, scene_factory) -> None:
+    path = _write_scene(tmp_path, scene_factory(film={"width": 30, "height": 20}))
+    out = tmp_path / "x.png"
+    proc = _demo("--scene", str(path), "--out", str(out), "--backend", "cpu")
+    assert proc.returncode == 0, proc.stderr
+    with Image.open(out) as png:
+        assert png.size == (30, 20)
+        assert np.asarray(png).any()
+
+
+def test_demo_auto_backend_renders(tmp_path: Path, scene_file: Path) -> None:
+    out = tmp_path / "x.png"
+    proc = _demo("--scene", str(scene_file), "--out", str(out), "--width", "16", "--height", "12")
+    assert proc.returncode == 0, proc.stderr
+    assert out.is_file()
+
+
+@pytest.mark.parametrize(("edit", "field"), [
+    (lambda s: s["camera"].update(fov_y=200), "camera.fov_y"),
+    (lambda s: s["medium"].update(sigma_t=-1), "medium.sigma_t"),
+    (lambda s: s["surfaces"][1].update(max=[-4, 0, -12]), "surfaces[1].max"),
+    (lambda s: s.update(camra=s.pop("camera")), "camra"),
+    (lambda s: s["lights"][0].update(type="spot"), "lights[0].type"),
+    (lambda s: s["film"].update(width="wide"), "film.width"),
+])
+def test_demo_bad_scene_exits_nonzero_with_one_line_naming_the_field(
+        tmp_path: Path, scene_factory, edit, field: str) -> None:
+    scene = scene_factory()
+    edit(scene)
+    out = tmp_path / "x.png"
+    proc = _demo("--scene", str(_write_scene(tmp_path, scene)), "--out", str(out), "--backend", "cpu")
+    _assert_one_line_error(proc, field)
+    assert not out.exists()
+
+
+def test_demo_invalid_json_exits_nonzero_with_one_line(tmp_path: Path) -> None:
+    path = tmp_path / "broken.json"
+    path.write_text('{"film": {"width": 10,\n\n "height": }')
+    _assert_one_line_error(_demo("--scene", str(path), "--out", str(tmp_path / "x.png"), "--backend", "cpu"),
+                           "JSON")
+
+
+def test_demo_missing_scene_file_exits_nonzero_with_one_line(tmp_path: Path) -> None:
+    missing = tmp_path / "missing.json"
+    _assert_one_line_error(_demo("--scene", str(missing), "--out", str(tmp_path / "x.png")), str(missing))
+
+
+@pytest.mark.parametrize("args", [["--bogus", "1"], ["--bogus"], ["-x"], ["extra"]])
+def test_demo_unknown_option_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path, args) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), *args)
+    _assert_one_line_error(proc, args[0])
+    assert not (tmp_path / "x.png").exists()
+
+
+@pytest.mark.parametrize("value", ["0", "-3", "abc", "12abc", "16385", "1.5", ""])
+def test_demo_bad_width_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path, value: str) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), "--width", value)
+    _assert_one_line_error(proc, "--width")
+
+
+def test_demo_bad_height_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), "--height", "0")
+    _assert_one_line_error(proc, "--height")
+
+
+@pytest.mark.parametrize("value", ["-1", "nan", "inf", "bright"])
+def test_demo_bad_exposure_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path, value: str) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), "--exposure", value)
+    _assert_one_line_error(proc, "--exposure")
+
+
+@pytest.mark.parametrize("name", ["x.jpg", "x.PNG.txt", "x", "x.exr"])
+def test_demo_unsupported_output_extension_exits_nonzero_with_one_line(
+        tmp_path: Path, scene_file: Path, name: str) -> None:
+    out = tmp_path / name
+    _assert_one_line_error(_demo("--scene", str(scene_file), "--out", str(out)), "--out")
+    assert not out.exists()
+
+
+def test_demo_bad_backend_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), "--backend", "vulkan")
+    _assert_one_line_error(proc, "--backend")
+
+
+def test_demo_missing_required_options_exit_nonzero_with_one_line(tmp_path: Path, scene_file: Path) -> None:
+    _assert_one_line_error(_demo("--out", str(tmp_path / "x.png")), "--scene")
+    _assert_one_line_error(_demo("--scene", str(scene_file)), "--out")
+    _assert_one_line_error(_demo("--scene"), "--scene")
+
+
+def test_demo_unwritable_output_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path) -> None:
+    out = tmp_path / "no_such_dir" / "x.png"
+    _assert_one_line_error(_demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu",
+                                 "--width", "8", "--height", "8"), str(out))
+
+
+def test_demo_help_exits_zero_with_usage() -> None:
+    for flag in ("--help", "-h"):
+        proc = _demo(flag)
+        assert proc.returncode == 0
+        assert "usage" in proc.stdout and "--scene" in proc.stdout
+        assert proc.stderr == ""
+
+
+def _demo_without_gl(*args: str) -> subprocess.CompletedProcess:
+    if not DEMO.exists():
+        pytest.skip(f"{DEMO} is not installed")
+    env = {**os.environ, "AIRLIGHT_DISABLE_GL": "1"}
+    return subprocess.run([str(DEMO), *args], capture_output=True, text=True, timeout=60, env=env)
+
+
+def test_demo_gl_backend_where_unavailable_exits_nonzero_with_one_line(
+        tmp_path: Path, scene_file: Path) -> None:
+    out = tmp_path / "x.png"
+    proc = _demo_without_gl("--scene", str(scene_file), "--out", str(out), "--backend", "gl")
+    _assert_one_line_error(proc, "GL")
+    assert not out.exists()
+
+
+def test_demo_auto_backend_falls_back_to_cpu_where_gl_is_unavailable(
+        tmp_path: Path, scene_file: Path) -> None:
+    out = tmp_path / "x.pfm"
+    proc = _demo_without_gl("--scene", str(scene_file), "--out", str(out), "--width", "16", "--height", "12")
+    assert proc.returncode == 0, proc.stderr
+    assert "cpu" in proc.stdout
+    assert out.is_file()

@@ -1,0 +1,404 @@
+"""Scene validation through the Python API: every bad input raises TypeError (wrong
+JSON type) or ValueError (bad value) naming the offending field, and nothing else
+ever escapes; random valid scenes render to finite, non-negative radiance."""
+
+from __future__ import annotations
+
+import copy
+import math
+import re
+from typing import Any, Callable
+
+import airlight
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, assume, given, settings
+from hypothesis import strategies as st
+
+VALID: dict[str, Any] = {
+    "film": {"width": 24, "height": 16},
+    "camera": {"position": [0.0, 1.7, 0.0], "look_at": [0.0, 1.7, -10.0], "up": [0.0, 1.0, 0.0],
+               "fov_y": 60.0},
+    "medium": {"sigma_t": 0.05, "albedo": 1.0, "phase": {"type": "isotropic"}},
+    "lights": [
+        {"type": "point", "position": [3.0, 5.0, -20.0], "intensity": [100.0, 90.0, 70.0], "radius": 0.1},
+    ],
+    "surfaces": [
+        {"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "albedo": [0.3, 0.3, 0.3]},
+        {"type": "box", "min": [-8.0, 0.0, -40.0], "max": [-4.0, 12.0, -25.0], "albedo": 0.5},
+        {"type": "sphere", "center": [1.0, 1.0, -15.0], "radius": 1.0, "albedo": [0.7, 0.2, 0.2]},
+    ],
+    "background": [0.0, 0.0, 0.0],
+}
+
+
+def _set(path: str, value: Any) -> Callable[[dict], None]:
+    """Mutation setting the dotted/indexed ``path`` (e.g. "surfaces[1].max") to value."""
+    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
+
+    def mutate(scene: dict) -> None:
+        node = scene
+        for k in keys[:-1]:
+            node = node[k]
+        node[keys[-1]] = value
+
+    return mutate
+
+
+def _delete(path: str) -> Callable[[dict], None]:
+    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
+
+    def mutate(scene: dict) -> None:
+        node = scene
+        for k in keys[:-1]:
+            node = node[k]
+        del node[keys[-1]]
+
+    return mutate
+
+
+def _rename(path: str, new_key: str) -> Callable[[dict], None]:
+    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
+
+    def mutate(scene: dict) -> None:
+        node = scene
+        for k in keys[:-1]:
+            node = node[k]
+        node[new_key] = node.pop(keys[-1])
+
+    return mutate
+
+
+NAN, INF = float("nan"), float("inf")
+
+# (id, mutation, exception type, field the message must start with)
+BAD_SCENES = [
+    ("missing_camera", _delete("camera"), ValueError, "camera"),
+    ("missing_film", _delete("film"), ValueError, "film"),
+    ("missing_fov_y", _delete("camera.fov_y"), ValueError, "camera.fov_y"),
+    ("missing_sigma_t", _delete("medium.sigma_t"), ValueError, "medium.sigma_t"),
+    ("missing_light_intensity", _delete("lights[0].intensity"), ValueError, "lights[0].intensity"),
+    ("missing_light_type", _delete("lights[0].type"), ValueError, "lights[0].type"),
+    ("missing_sphere_radius", _delete("surfaces[2].radius"), ValueError, "surfaces[2].radius"),
+    ("misspelt_camera", _rename("camera", "camra"), ValueError, "camra"),
+    ("misspelt_sigma_t", _rename("medium.sigma_t", "sigmat"), ValueError, "medium.sigmat"),
+    ("misspelt_box_max", _rename("surfaces[1].max", "maxx"), ValueError, "surfaces[1].maxx"),
+    ("key_of_other_surface_type", _set("surfaces[2].normal", [0, 1, 0]), ValueError, "surfaces[2].normal"),
+    ("string_for_number", _set("camera.fov_y", "60"), TypeError, "camera.fov_y"),
+    ("bool_for_number", _set("camera.fov_y", True), TypeError, "camera.fov_y"),
+    ("bool_for_width", _set("film.width", False), TypeError, "film.width"),
+    ("none_for_number", _set("lights[0].radius", None), TypeError, "lights[0].radius"),
+    ("string_in_vector", _set("camera.position", [0, "1", 0]), TypeError, "camera.position"),
+    ("dict_for_list", _set("lights", {"type": "point"}), TypeError, "lights"),
+    ("dict_for_vector", _set("surfaces[0].point", {"x": 0}), TypeError, "surfaces[0].point"),
+    ("list_for_object", _set("film", [24, 16]), TypeError, "film"),
+    ("number_for_surface", _set("surfaces[1]", 3), TypeError, "surfaces[1]"),
+    ("number_for_type_name", _set("surfaces[0].type", 0), TypeError, "surfaces[0].type"),
+    ("two_element_vector", _set("camera.look_at", [0, 1]), ValueError, "camera.look_at"),
+    ("four_element_rgb", _set("background", [0, 0, 0, 0]), ValueError, "background"),
+    ("negative_sigma_t", _set("medium.sigma_t", -0.1), ValueError, "medium.sigma_t"),
+    ("negative_sigma_t_channel", _set("medium.sigma_t", [0.1, -0.1, 0.1]), ValueError, "medium.sigma_t"),
+    ("nan_sigma_t", _set("medium.sigma_t", NAN), ValueError, "medium.sigma_t"),
+    ("inf_sigma_t", _set("medium.sigma_t", INF), ValueError, "medium.sigma_t"),
+    ("nan_intensity_channel", _set("lights[0].intensity", [1, NAN, 1]), ValueError, "lights[0].intensity"),
+    ("negative_intensity", _set("lights[0].intensity", -5), ValueError, "lights[0].intensity"),
+    ("nan_position", _set("camera.position", [0, NAN, 0]), ValueError, "camera.position"),
+    ("inf_position", _set("lights[0].position", [INF, 0, 0]), ValueError, "lights[0].position"),
+    ("negative_background", _set("background", -1), ValueError, "background"),
+    ("surface_albedo_above_1", _set("surfaces[2].albedo", 1.5), ValueError, "surfaces[2].albedo"),
+    ("surface_albedo_channel_above_1", _set("surfaces[0].albedo", [0.3, 1.01, 0.3]), ValueError,
+     "surfaces[0].albedo"),
+    ("medium_albedo_above_1", _set("medium.albedo", 2.0), ValueError, "medium.albedo"),
+    ("negative_albedo", _set("surfaces[1].albedo", -0.5), ValueError, "surfaces[1].albedo"),
+    ("zero_width", _set("film.width", 0), ValueError, "film.width"),
+    ("zero_height", _set("film.height", 0), ValueError, "film.height"),
+    ("width_too_large", _set("film.width", 16385), ValueError, "film.width"),
+    ("height_too_large", _set("film.height", 100000), ValueError, "film.height"),
+    ("fractional_width", _set("film.width", 24.5), ValueError, "film.width"),
+    ("look_at_equals_position", _set("camera.look_at", [0.0, 1.7, 0.0]), ValueError, "camera.look_at"),
+    ("up_parallel_to_view", _set("camera.up", [0.0, 0.0, -1.0]), ValueError, "camera.up"),
+    ("up_antiparallel_to_view", _set("camera.up", [0.0, 0.0, 5.0]), ValueError, "camera.up"),
+    ("zero_up", _set("camera.up", [0.0, 0.0, 0.0]), ValueError, "camera.up"),
+    ("fov_y_zero", _set("camera.fov_y", 0), ValueError, "camera.fov_y"),
+    ("fov_y_180", _set("camera.fov_y", 180), ValueError, "camera.fov_y"),
+    ("fov_y_negative", _set("camera.fov_y", -5), ValueError, "camera.fov_y"),
+    ("fov_y_nan", _set("camera.fov_y", NAN), ValueError, "camera.fov_y"),
+    ("zero_plane_normal", _set("surfaces[0].normal", [0, 0, 0]), ValueError, "surfaces[0].normal"),
+    ("unknown_light_type", _set("lights[0].type", "spot"), ValueError, "lights[0].type"),
+    ("unknown_surface_type", _set("surfaces[1].type", "cylinder"), ValueError, "surfaces[1].type"),
+    ("unknown_phase_type", _set("medium.phase.type", "rayleigh"), ValueError, "medium.phase.type"),
+    ("box_min_equals_max", _set("surfaces[1].max", [-8.0, 12.0, -25.0]), ValueError, "surfaces[1].max"),
+    ("box_min_above_max", _set("surfaces[1].min", [-3.0, 0.0, -40.0]), ValueError, "surfaces[1].max"),
+    ("zero_sphere_radius", _set("surfaces[2].radius", 0), ValueError, "surfaces[2].radius"),
+    ("negative_light_radius", _set("lights[0].radius", -0.1), ValueError, "lights[0].radius"),
+    ("absurd_coordinate", _set("surfaces[2].center", [1e8, 0, 0]), ValueError, "surfaces[2].center"),
+    ("unknown_top_level_key", _set("fog", 1), ValueError, "fog"),
+    ("non_string_dict_key", _set("camera", {1: 2}), TypeError, "camera"),
+    ("unsupported_python_type", _set("camera.position", {0, 1, 2}), TypeError, "camera.position"),
+]
+
+
+BAD_IDS = [b[0] for b in BAD_SCENES]
+
+
+def _bad(mutate: Callable[[dict], None]) -> dict:
+    scene = copy.deepcopy(VALID)
+    mutate(scene)
+    return scene
+
+
+def test_valid_base_scene_loads_and_is_normalised() -> None:
+    loaded = airlight.load_scene(VALID)
+    assert loaded["surfaces"][1]["albedo"] == [0.5, 0.5, 0.5]
+    assert loaded["medium"]["sigma_t"] == pytest.approx([0.05] * 3)
+
+
+@pytest.mark.parametrize(("mutate", "exc", "field"), [b[1:] for b in BAD_SCENES], ids=BAD_IDS)
+def test_load_scene_rejects_bad_input_naming_the_field(mutate, exc, field) -> None:
+    with pytest.raises(exc) as info:
+        airlight.load_scene(_bad(mutate))
+    assert type(info.value) is exc, f"expected exactly {exc.__name__}, got {type(info.value).__name__}"
+    message = str(info.value)
+    assert message.startswith(field + ":"), f"message {message!r} does not start with {field!r}"
+
+
+@pytest.mark.parametrize(("mutate", "exc", "field"), [b[1:] for b in BAD_SCENES], ids=BAD_IDS)
+def test_render_rejects_bad_input_naming_the_field(mutate, exc, field) -> None:
+    with pytest.raises(exc, match="^" + re.escape(field) + ":"):
+        airlight.render(_bad(mutate), backend="cpu")
+
+
+@pytest.mark.parametrize("scene", [5, 3.5, None, [VALID], b"{}", (1, 2)], ids=repr)
+def test_non_dict_scene_is_a_type_error(scene) -> None:
+    with pytest.raises(TypeError, match="scene"):
+        airlight.load_scene(scene)
+    with pytest.raises(TypeError, match="scene"):
+        airlight.render(scene, backend="cpu")
+
+
+def test_json_text_that_is_not_an_object_is_a_type_error() -> None:
+    # Text starting with "{" is JSON; a JSON list is read from a file to test it.
+    with pytest.raises(ValueError, match="invalid JSON"):
+        airlight.load_scene("{not json")
+
+
+def test_json_file_holding_a_list_is_a_type_error(tmp_path) -> None:
+    path = tmp_path / "list.json"
+    path.write_text("[1, 2, 3]")
+    with pytest.raises(TypeError, match="object"):
+        airlight.load_scene(str(path))
+
+
+def test_unreadable_path_is_a_value_error_naming_path(tmp_path) -> None:
+    missing = tmp_path / "does_not_exist.json"
+    with pytest.raises(ValueError, match="^path:"):
+        airlight.load_scene(str(missing))
+    with pytest.raises(ValueError, match="^path:"):
+        airlight.load_scene(missing)
+    with pytest.raises(ValueError, match="^path:"):
+        airlight.render(str(missing), backend="cpu")
+    with pytest.raises(ValueError, match="^path:"):
+        airlight.load_scene(str(tmp_path))  # a directory
+
+
+def test_path_with_a_nul_byte_is_a_value_error_naming_path() -> None:
+    with pytest.raises(ValueError, match="^path:"):
+        airlight.load_scene("scene\0.json")
+
+
+def test_bad_film_override_is_rejected_naming_the_film_field() -> None:
+    with pytest.raises(ValueError, match="^film.width:"):
+        airlight.render(VALID, backend="cpu", width=0)
+    with pytest.raises(ValueError, match="^film.height:"):
+        airlight.render(VALID, backend="cpu", height=16385)
+    with pytest.raises(TypeError, match="^film.width:"):
+        airlight.render(VALID, backend="cpu", width="24")
+
+
+def test_huge_python_integer_is_a_value_error_not_a_runtime_error() -> None:
+    with pytest.raises(ValueError, match="^camera.fov_y"):
+        airlight.load_scene(_bad(_set("camera.fov_y", 10**400)))
+    with pytest.raises(ValueError, match="^lights"):
+        airlight.load_scene(_bad(_set("lights[0].position", [10**400, 0, 0])))
+
+
+def test_unencodable_string_is_a_type_or_value_error_not_a_runtime_error() -> None:
+    # A lone surrogate cannot be encoded as UTF-8.
+    with pytest.raises((TypeError, ValueError)):
+        airlight.load_scene(_bad(_set("surfaces[0].type", "\ud800")))
+    with pytest.raises((TypeError, ValueError)):
+        airlight.load_scene(_bad(_set("\ud800", 1)))
+
+
+def test_non_string_top_level_key_error_names_a_field() -> None:
+    scene = copy.deepcopy(VALID)
+    scene[1] = 2
+    with pytest.raises(TypeError) as info:
+        airlight.load_scene(scene)
+    assert not str(info.value).startswith(":"), f"message with an empty field: {str(info.value)!r}"
+
+
+def test_numpy_values_are_accepted_as_numbers() -> None:
+    scene = copy.deepcopy(VALID)
+    scene["camera"]["position"] = np.array([0.0, 1.7, 0.0])
+    scene["camera"]["fov_y"] = np.float32(45.0)
+    scene["film"]["width"] = np.int64(24)
+    loaded = airlight.load_scene(scene)
+    assert loaded["camera"]["fov_y"] == 45.0 and loaded["film"]["width"] == 24
+
+
+def test_zero_dimensional_numpy_array_is_accepted_as_a_number() -> None:
+    loaded = airlight.load_scene(_bad(_set("camera.fov_y", np.array(45.0))))
+    assert loaded["camera"]["fov_y"] == 45.0
+
+
+# --- property-based: garbage never crashes ------------------------------------------------
+
+_garbage = st.recursive(
+    st.none() | st.booleans() | st.integers() | st.floats(allow_nan=True, allow_infinity=True)
+    | st.text(max_size=10) | st.sampled_from(["plane", "box", "sphere", "point", "isotropic", ""]),
+    lambda children: st.lists(children, max_size=4)
+    | st.dictionaries(st.text(max_size=8) | st.sampled_from(["type", "position", "radius", "min", "max"]),
+                      children, max_size=4),
+    max_leaves=12,
+)
+
+
+def _containers(node: Any, out: list) -> list:
+    """Every dict and list inside ``node`` (``node`` included)."""
+    out.append(node)
+    children = node.values() if isinstance(node, dict) else node if isinstance(node, list) else ()
+    for child in children:
+        if isinstance(child, (dict, list)):
+            _containers(child, out)
+    return out
+
+
+@settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(data=st.data())
+def test_garbage_anywhere_in_a_scene_raises_only_type_or_value_errors(data) -> None:
+    scene = copy.deepcopy(VALID)
+    for _ in range(data.draw(st.integers(1, 3), label="edits")):
+        container = data.draw(st.sampled_from(_containers(scene, [])), label="container")
+        action = data.draw(st.sampled_from(["replace", "insert", "delete"]), label="action")
+        value = data.draw(_garbage, label="value")
+        if isinstance(container, dict):
+            if action == "insert" or not container:
+                known = st.sampled_from(sorted(container) or ["x"])
+                key = data.draw(st.text(max_size=8) | known, label="key")
+                container[key] = value
+            else:
+                key = data.draw(st.sampled_from(sorted(container)), label="key")
+                if action == "delete":
+                    del container[key]
+                else:
+                    container[key] = value
+        else:
+            if action == "insert" or not container:
+                container.insert(data.draw(st.integers(0, len(container)), label="at"), value)
+            else:
+                i = data.draw(st.integers(0, len(container) - 1), label="index")
+                if action == "delete":
+                    del container[i]
+                else:
+                    container[i] = value
+    try:
+        airlight.load_scene(scene)
+    except (TypeError, ValueError):
+        return
+    # Valid after all: it must render (on a tiny film, whatever its film says).
+    try:
+        img = airlight.render(scene, backend="cpu", width=8, height=6)
+    except (TypeError, ValueError):
+        return
+    assert img.shape == (6, 8, 3)
+
+
+@settings(max_examples=100, deadline=None)
+@given(scene=_garbage)
+def test_garbage_as_the_whole_scene_raises_only_type_or_value_errors(scene) -> None:
+    try:
+        airlight.load_scene(scene)
+    except (TypeError, ValueError):
+        pass
+
+
+# --- property-based: random valid scenes render sanely -------------------------------------
+
+_coord = st.floats(-100.0, 100.0, allow_nan=False)
+_point = st.lists(_coord, min_size=3, max_size=3)
+_rgb01 = st.lists(st.floats(0.0, 1.0), min_size=3, max_size=3)
+
+
+@st.composite
+def _valid_scenes(draw) -> dict[str, Any]:
+    position = draw(_point)
+    look_at = draw(_point)
+    up = draw(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3))
+    view = np.subtract(look_at, position)
+    assume(np.linalg.norm(view) > 1e-3)
+    assume(np.linalg.norm(np.cross(view / np.linalg.norm(view), up)) > 1e-3 * max(np.linalg.norm(up), 1e-30))
+    assume(np.linalg.norm(up) > 1e-3)
+    scene: dict[str, Any] = {
+        "film": {"width": 24, "height": 16},
+        "camera": {"position": position, "look_at": look_at, "up": up, "fov_y": draw(st.floats(1.0, 170.0))},
+        "background": draw(st.lists(st.floats(0.0, 10.0), min_size=3, max_size=3)),
+    }
+    if draw(st.booleans()):
+        scene["medium"] = {"sigma_t": draw(st.lists(st.floats(0.0, 2.0), min_size=3, max_size=3)),
+                           "albedo": draw(_rgb01)}
+    scene["lights"] = [
+        {"type": "point", "position": draw(_point),
+         "intensity": draw(st.lists(st.floats(0.0, 1000.0), min_size=3, max_size=3)),
+         "radius": draw(st.floats(0.01, 10.0))}
+        for _ in range(draw(st.integers(0, 4)))
+    ]
+    surfaces = []
+    for _ in range(draw(st.integers(0, 4))):
+        kind = draw(st.sampled_from(["plane", "box", "sphere"]))
+        albedo = draw(_rgb01)
+        if kind == "plane":
+            normal = draw(st.lists(st.floats(-1.0, 1.0), min_size=3, max_size=3))
+            assume(np.linalg.norm(normal) > 1e-3)
+            surfaces.append({"type": "plane", "point": draw(_point), "normal": normal, "albedo": albedo})
+        elif kind == "box":
+            lo = draw(_point)
+            size = draw(st.lists(st.floats(0.01, 50.0), min_size=3, max_size=3))
+            hi = [a + b for a, b in zip(lo, size)]
+            surfaces.append({"type": "box", "min": lo, "max": hi, "albedo": albedo})
+        else:
+            surfaces.append({"type": "sphere", "center": draw(_point), "radius": draw(st.floats(0.01, 50.0)),
+                             "albedo": albedo})
+    scene["surfaces"] = surfaces
+    return scene
+
+
+@pytest.fixture(scope="module")
+def renderers_for_property_test(renderer_cache) -> list[airlight.Renderer]:
+    names = ["cpu"] if airlight.gl_unavailable_reason() is not None else ["cpu", "gl"]
+    return [renderer_cache(name) for name in names]
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture,
+                                                                   HealthCheck.filter_too_much])
+@given(scene=_valid_scenes())
+def test_random_valid_scenes_render_finite_non_negative_radiance(scene, renderers_for_property_test) -> None:
+    airlight.load_scene(scene)  # valid by construction
+    for renderer in renderers_for_property_test:
+        img = renderer.render(scene)
+        assert img.shape == (16, 24, 3)
+        bad = ~np.isfinite(img) | (img < 0)
+        assert not bad.any(), (
+            f"{renderer.backend}: {int(bad.sum())} bad values, e.g. {img[bad][:4]!r} "
+            f"at {np.argwhere(bad)[:2].tolist()}")
+
+
+def test_light_radius_default_and_bounds_follow_the_format() -> None:
+    scene = copy.deepcopy(VALID)
+    del scene["lights"][0]["radius"]
+    assert airlight.load_scene(scene)["lights"][0]["radius"] == pytest.approx(0.05)
+    scene["lights"][0]["radius"] = 1000.0
+    assert math.isclose(airlight.load_scene(scene)["lights"][0]["radius"], 1000.0)
+    scene["lights"][0]["radius"] = 1000.5
+    with pytest.raises(ValueError, match="^lights\\[0\\].radius:"):
+        airlight.load_scene(scene)
