@@ -33,33 +33,18 @@ FrameData make_frame_data(const Scene& scene) {
     f.sigma_s = glm::vec4(sigma_s, 0.0f);
     f.background = glm::vec4(scene.background, 0.0f);
 
-    // Culling (docs/culling.md). Reference radiance: the brightest of, over
-    // lights, the glow 1 m from the lamp in its own fog (sigma_s I / 4) and a
-    // white surface 5 m from it (I / (25 pi)). A light's largest possible
-    // radiance anywhere in the frame is bounded by e^{-sigma_t (D - r)} I times
-    // the largest of its core (1 / (pi r^2)), its airlight (sigma_s / (4 r)) and
-    // its surface glow (sigma_s G(0, 0) / (2 pi^2 r)), because every path from
-    // the light to the camera is at least D - r long.
-    float reference = 0.0f;
-    for (const PointLight& light : scene.point_lights) {
-        const glm::vec3 white = light.intensity * glm::max(sigma_s * 0.25f, glm::vec3(1.0f / (25.0f * shader::PI)));
-        reference = std::max(reference, glm::compMax(white));
-    }
-    const float cull_radiance = scene.quality.cull_fraction * reference;
-    const float glow_max = scattering && !scene.point_lights.empty() ? surface_glow_table().texels[0] : 0.0f;  // G(0, 0) is the largest
-    const float min_sigma_t = glm::compMin(sigma_t);
+    // Lights in order of decreasing brightness seen from the camera, so that
+    // the per-pixel culling (docs/culling.md) meets the bright ones first.
+    std::vector<PointLight> lights = scene.point_lights;
+    auto brightness = [&](const PointLight& l) {
+        const float dist = glm::length(l.position - cam.position);
+        return glm::compMax(l.intensity * glm::exp(-sigma_t * dist)) / std::max(dist * dist, l.radius * l.radius);
+    };
+    std::stable_sort(lights.begin(), lights.end(),
+                     [&](const PointLight& a, const PointLight& b) { return brightness(a) > brightness(b); });
     float farthest = 0.0f;
-    for (const PointLight& light : scene.point_lights) {
-        const float r = light.radius;
-        const float dist = glm::length(light.position - cam.position);
-        const float per_intensity = std::max({1.0f / (shader::PI * r * r), glm::compMax(sigma_s) / (4.0f * r),
-                                              glm::compMax(sigma_s) * glow_max / (2.0f * shader::PI * shader::PI * r)});
-        const float bound = glm::compMax(light.intensity) * per_intensity * std::exp(-min_sigma_t * std::max(dist - r, 0.0f));
-        if (bound < cull_radiance) {
-            ++data.lights_culled;
-            continue;
-        }
-        farthest = std::max(farthest, dist);
+    for (const PointLight& light : lights) {
+        farthest = std::max(farthest, glm::length(light.position - cam.position));
         data.point_lights.push_back({glm::vec4(light.position, light.radius), glm::vec4(light.intensity, 0.0f)});
     }
     // Ray marching (benchmarks): escaping rays are cut where the transmittance
@@ -68,7 +53,14 @@ FrameData make_frame_data(const Scene& scene) {
     for (int c = 0; c < 3; ++c)
         if (sigma_s[c] > 0.0f) thinnest = std::min(thinnest, sigma_t[c]);
     const float march_far = scattering ? farthest + 16.0f / thinnest : 0.0f;
-    f.quality = glm::vec4(cull_radiance, float(scene.quality.march_steps), march_far, 0.0f);
+    // Upper bound of the glow table G over all (T, theta_s), with a margin
+    // for its interpolation error, for the culling bound of the surface glow.
+    float glow_bound = 0.0f;
+    if (scattering && !lights.empty()) {
+        const std::vector<float>& log_glow = surface_glow_table().texels;
+        glow_bound = 1.01f * std::exp(*std::max_element(log_glow.begin(), log_glow.end()));
+    }
+    f.quality = glm::vec4(scene.quality.cull_fraction, float(scene.quality.march_steps), march_far, glow_bound);
     for (const Surface& s : scene.surfaces) {
         shader::SurfaceGpu g{};
         switch (s.type) {

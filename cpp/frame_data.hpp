@@ -18,13 +18,11 @@ struct FrameData {
     // they are then never built).
     const Table2D* airlight_tail = nullptr;
     const Table2D* surface_glow = nullptr;
-    int lights_culled = 0;  // point lights dropped for the whole frame (docs/culling.md)
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and
 // surfaces, the feature set that selects the shader variant, and the tables
-// that variant needs. Lights whose contribution to every pixel is provably
-// below the cull radiance are dropped here.
+// that variant needs. Lights are sorted brightest first for the culling.
 FrameData make_frame_data(const Scene& scene);
 
 }  // namespace airlight

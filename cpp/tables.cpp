@@ -4,6 +4,7 @@
 
 #include <atomic>
 #include <chrono>
+#include <algorithm>
 #include <cmath>
 #include <complex>
 #include <mutex>
@@ -64,12 +65,18 @@ Table2D timed_build(Build build) {
 // Quadrature nodes in g in [0, pi] for the glow integral: panels graded
 // geometrically towards g = 0, where Q(T sin g, g/2) has a boundary layer of
 // width ~1/T, then uniform. Returns (g, weight) pairs.
-std::vector<std::pair<double, double>> glow_nodes(int scale) {
-    std::vector<double> edges = {0.0};
+// Panel edges also sit at pi/2, where Phi has a kink for theta_s = 0 or pi,
+// and at the given extra points (the other places where Phi changes form).
+std::vector<std::pair<double, double>> glow_nodes(int scale, std::vector<double> extra_edges = {}) {
+    std::vector<double> edges = {0.0, 0.5 * kPi};
     for (double e = 1e-5; e < 0.5; e *= 1.0 + 0.6 / scale) edges.push_back(e);
     const int uniform_panels = 24 * scale;
     const double start = edges.back();
     for (int i = 1; i <= uniform_panels; ++i) edges.push_back(start + (kPi - start) * i / uniform_panels);
+    for (double e : extra_edges)
+        if (e > 0.0 && e < kPi) edges.push_back(e);
+    std::sort(edges.begin(), edges.end());
+    edges.erase(std::unique(edges.begin(), edges.end()), edges.end());
     std::vector<std::pair<double, double>> nodes;
     for (size_t p = 0; p + 1 < edges.size(); ++p) {
         const double mid = 0.5 * (edges[p] + edges[p + 1]), half = 0.5 * (edges[p + 1] - edges[p]);
@@ -80,6 +87,11 @@ std::vector<std::pair<double, double>> glow_nodes(int scale) {
 
 }  // namespace
 
+double surface_glow_cos_theta(double Y, double optical_distance) {
+    const double s = 2.0 * Y - 1.0, k = std::max(double(float(std::max(optical_distance, 1e-4))), 1e-4);
+    return std::clamp(std::sinh(s * std::asinh(k)) / k, -1.0, 1.0);
+}
+
 double airlight_tail_exact(double u, double cv) {
     if (cv <= 0.0) return 0.0;
     if (u <= 0.0) return cv;
@@ -89,7 +101,8 @@ double airlight_tail_exact(double u, double cv) {
 
 double surface_glow_exact(double optical_distance, double theta_s, int nodes_scale) {
     double sum = 0.0;
-    for (const auto& [g, w] : glow_nodes(nodes_scale)) {
+    const double h = 0.5 * kPi;
+    for (const auto& [g, w] : glow_nodes(nodes_scale, {h - theta_s, theta_s - h, h + theta_s, 3.0 * h - theta_s})) {
         const double ring = clamped_cosine_ring(g, theta_s);
         if (ring == 0.0) continue;
         sum += w * ring * airlight_tail_exact(optical_distance * std::sin(g), 0.5 * (kPi - g));
@@ -130,33 +143,39 @@ const Table2D& airlight_tail_table() {
 
 const Table2D& surface_glow_table() {
     static const Table2D table = timed_build([] {
+        return build_surface_glow_table(shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY);
+    });
+    return table;
+}
+
+Table2D build_surface_glow_table(int width, int height) {
         using namespace shader;
         Table2D t;
-        t.width = SURFACE_GLOW_NX;
-        t.height = SURFACE_GLOW_NY;
+        t.width = width;
+        t.height = height;
         t.texels.resize(size_t(t.width) * t.height);
         const auto nodes = glow_nodes(1);
         std::vector<double> q(nodes.size());
         for (int ix = 0; ix < t.width; ++ix) {
             const double X = double(ix) / (t.width - 1);
-            const double T = X * X * double(SURFACE_GLOW_T_MAX);
+            const double t0 = double(SURFACE_GLOW_T_SCALE);
+            const double T = t0 * std::expm1(X * X * std::log1p(double(SURFACE_GLOW_T_MAX) / t0));
             // Q depends on T and g only: evaluate once per column, reuse for every theta_s.
             for (size_t n = 0; n < nodes.size(); ++n) {
                 const double g = nodes[n].first;
                 q[n] = airlight_tail_exact(T * std::sin(g), 0.5 * (kPi - g));
             }
             for (int iy = 0; iy < t.height; ++iy) {
-                const double theta_s = kPi * iy / (t.height - 1);
+                const double c = surface_glow_cos_theta(double(iy) / (t.height - 1), T);
+                const double theta_s = std::acos(c);
                 double sum = 0.0;
                 for (size_t n = 0; n < nodes.size(); ++n) {
                     sum += nodes[n].second * q[n] * clamped_cosine_ring(nodes[n].first, theta_s);
                 }
-                t.texels[size_t(iy) * t.width + ix] = float(sum);
+                t.texels[size_t(iy) * t.width + ix] = float(std::log(sum));
             }
         }
         return t;
-    });
-    return table;
 }
 
 int tables_built() { return built_count.load(); }

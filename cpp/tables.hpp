@@ -27,6 +27,14 @@ double airlight_tail_exact(double u, double cv);
 // the quadrature (tests use it to check convergence).
 double surface_glow_exact(double optical_distance, double theta_s, int nodes_scale = 1);
 
+// Inverse of the glow table's row coordinate (shaders/airlight.glsl):
+// cos theta_s at row coordinate Y in [0, 1] and optical distance T.
+double surface_glow_cos_theta(double Y, double optical_distance);
+
+// Builds a surface glow table of any resolution (the production one uses
+// SURFACE_GLOW_NX x SURFACE_GLOW_NY; other sizes are for the error analysis).
+Table2D build_surface_glow_table(int width, int height);
+
 // The tables, built on first use (thread safe) and kept for the process.
 const Table2D& airlight_tail_table();
 const Table2D& surface_glow_table();

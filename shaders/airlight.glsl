@@ -68,9 +68,23 @@ float airlight_segment(float sigma, float b, float h, float x0, float x1) {
 // ---- Light scattered onto surfaces ----------------------------------------
 // G(T, theta_s) = e^{T} G0(T, theta_s); the irradiance from light scattered
 // once on the way is sigma_s I / (2 pi D) e^{-T} G (MODELS.md section 1).
+// Row coordinate: Y = (1 + asinh(T c) / asinh(T)) / 2, c = cos theta_s: linear in
+// c for thin media, logarithmic in c for optically distant lights, whose glow
+// turns from lit (c > 0) to unlit (c < 0) over a width ~1/T around c = 0.
+// log G(T, theta_s) from the table (it stores log G: interpolating the
+// logarithm keeps the relative error even where G varies like log(T) / T).
+float surface_glow_log_lookup(float optical_distance, float cos_theta_s, int nx, int ny) {
+    float c = clamp(cos_theta_s, -1.0f, 1.0f);
+    float k = max(optical_distance, 1.0e-4f);
+    float Y = 0.5f + 0.5f * asinh(k * c) / asinh(k);
+    float X = sqrt(log(1.0f + optical_distance / SURFACE_GLOW_T_SCALE) /
+                   log(1.0f + SURFACE_GLOW_T_MAX / SURFACE_GLOW_T_SCALE));
+    return table_bilinear(TABLE_SURFACE_GLOW, nx, ny, X, Y);
+}
+
+// G0(T, theta_s) = e^{-T} G(T, theta_s).
 float surface_glow(float optical_distance, float cos_theta_s) {
     if (optical_distance >= SURFACE_GLOW_T_MAX) return 0.0f;
-    float theta_s = acos(clamp(cos_theta_s, -1.0f, 1.0f));
-    return exp(-optical_distance) * table_bilinear(TABLE_SURFACE_GLOW, SURFACE_GLOW_NX, SURFACE_GLOW_NY,
-                                                   sqrt(optical_distance / SURFACE_GLOW_T_MAX), theta_s / PI);
+    return exp(surface_glow_log_lookup(optical_distance, cos_theta_s, SURFACE_GLOW_NX, SURFACE_GLOW_NY) -
+               optical_distance);
 }

@@ -12,7 +12,7 @@ struct FrameUniforms {
     vec4 sigma_s;          // rgb: medium scattering (1/m) = albedo * sigma_t
     vec4 background;       // rgb: radiance of escaping rays, before attenuation
     ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
-    vec4 quality;          // x: cull radiance (W/(m^2 sr)), y: march steps, z: march far distance (m)
+    vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: bound of G
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting

@@ -7,13 +7,20 @@
 // t = NO_HIT (escaping ray) gives 0 on every channel with sigma_t > 0.
 vec3 transmittance(float t) {
     if (!HAS_MEDIUM) return vec3(1.0f);
-    return exp(-vec3(frame.sigma_t) * t);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    if (t >= NO_HIT) {  // explicit: exp(-0 * inf) may be NaN once a compiler reassociates
+        return vec3(sigma_t.x > 0.0f ? 0.0f : 1.0f, sigma_t.y > 0.0f ? 0.0f : 1.0f, sigma_t.z > 0.0f ? 0.0f : 1.0f);
+    }
+    return exp(-sigma_t * t);
 }
 
-// Offset that lifts a hit point off its surface before tracing shadow rays;
-// relative to the coordinates' magnitude so it outgrows float rounding.
+// Offset that lifts a hit point off its surface before tracing shadow rays:
+// a multiple of the float rounding of p (relative to its coordinates and to
+// the camera's, which p was computed from), so it works at any scale.
 float surface_offset(vec3 p) {
-    return 1.0e-4f * (1.0f + max(max(abs(p.x), abs(p.y)), abs(p.z)));
+    vec3 o = vec3(frame.camera_position);
+    float scale = max(max(abs(p.x), abs(p.y)), abs(p.z)) + max(max(abs(o.x), abs(o.y)), abs(o.z));
+    return 1.0e-5f * scale + 1.0e-30f;
 }
 
 // Light scattered once on its way from a lamp to a surface point at distance
@@ -29,6 +36,14 @@ vec3 surface_glow_per_intensity(float dist, float radius, float cos_theta_s) {
                     surface_glow(sigma_t.z * dist, cos_theta_s));
     }
     return vec3(frame.sigma_s) * glow / (2.0f * PI * max(dist, radius));
+}
+
+// True when a contribution bounded by `bound` is provably below the culling
+// fraction of `so_far`, a lower bound of the final value, on every channel
+// (docs/culling.md): skipping it changes the result by less than that fraction.
+bool negligible(vec3 bound, vec3 so_far) {
+    vec3 limit = frame.quality.x * so_far;
+    return bound.x < limit.x && bound.y < limit.y && bound.z < limit.z;
 }
 
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
@@ -48,11 +63,16 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         if (dist <= 0.0f) continue;
         vec3 l = to_light / dist;
         float cos_theta = dot(n, l);
-        if (HAS_AIRLIGHT) irradiance += vec3(light.intensity) * surface_glow_per_intensity(dist, radius, cos_theta);
+        vec3 intensity = vec3(light.intensity);
+        vec3 attenuation = transmittance(dist);
+        vec3 direct = cos_theta > 0.0f ? intensity * (cos_theta / max(dist2, radius * radius)) * attenuation : vec3(0.0f);
+        vec3 glow_bound = vec3(0.0f);
+        if (HAS_AIRLIGHT) glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (frame.quality.w / (2.0f * PI * max(dist, radius)));
+        if (negligible(direct + glow_bound, irradiance)) continue;
+        if (HAS_AIRLIGHT) irradiance += intensity * surface_glow_per_intensity(dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
-        irradiance += vec3(light.intensity) * (cos_theta / max(dist2, radius * radius)) *
-                      transmittance(dist);
+        irradiance += direct;
     }
     return irradiance;
 }
@@ -78,9 +98,10 @@ vec3 airlight_march(vec3 light_position, vec3 intensity, vec3 origin, vec3 dir, 
 // Airlight of point light `light` over the visible part [0, x_end] of the
 // view ray (MODELS.md section 1): sigma_s I / (2 pi h) times the segment
 // integral of airlight.glsl. A camera inside the lamp's sphere sees fog from
-// where the ray leaves the sphere. Skipped where the bound
-// sigma_s I e^{-sigma_t D} (pi / 2) / (2 pi h) is below frame.quality.x.
-vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_end) {
+// where the ray leaves the sphere. Skipped when its bound
+// sigma_s I e^{-sigma_t (D - r)} (pi / 2) / (2 pi h) is negligible against
+// `so_far` (the pixel's radiance found so far).
+vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_end, vec3 so_far) {
     vec3 to_light = vec3(light.position_radius) - origin;
     float radius = light.position_radius.w;
     float dist = length(to_light);
@@ -91,9 +112,7 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     if (x0 >= x_end) return vec3(0.0f);
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
-    float min_sigma_t = min(min(sigma_t.x, sigma_t.y), sigma_t.z);
-    float bound = max(max(scale.x, scale.y), scale.z) * (0.5f * PI) * exp(-min_sigma_t * max(dist - radius, 0.0f));
-    if (bound < frame.quality.x) return vec3(0.0f);
+    if (negligible(scale * (0.5f * PI) * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
     if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), origin, dir, x0, x_end);
     if (GREY_MEDIUM) return scale * airlight_segment(sigma_t.x, b, h, x0, x_end);
     return scale * vec3(airlight_segment(sigma_t.x, b, h, x0, x_end), airlight_segment(sigma_t.y, b, h, x0, x_end),
@@ -137,7 +156,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     // front of it adds its glow.
     radiance *= transmittance(t_hit);
     if (HAS_AIRLIGHT) {
-        for (int i = 0; i < point_light_count(); ++i) radiance += point_light_airlight(point_light(i), origin, dir, t_hit);
+        for (int i = 0; i < point_light_count(); ++i) {
+            radiance += point_light_airlight(point_light(i), origin, dir, t_hit, radiance);
+        }
     }
     return radiance;
 }

@@ -1,8 +1,13 @@
 """Both backends against the independent float64 reference (reference.py): direct
-lighting of Lambertian surfaces by point lamps through a homogeneous medium."""
+lighting of Lambertian surfaces by point lamps through a homogeneous medium.
+
+Every medium here is purely absorbing (albedo 0, so sigma_s = 0): the fog's own glow
+(airlight, single scattering) is not part of the direct-lighting model and is tested
+elsewhere; with sigma_s = 0 the direct model is the whole image."""
 
 from __future__ import annotations
 
+import copy
 from typing import Any
 
 import airlight
@@ -19,7 +24,7 @@ DIM_FRACTION = 1e-3
 MIN_TESTED = 5000  # channel values compared per scene, so that no test passes vacuously
 
 FILM = {"width": WIDTH, "height": HEIGHT}
-FOG = {"sigma_t": 0.05, "albedo": 1.0, "phase": {"type": "isotropic"}}
+FOG = {"sigma_t": 0.05, "albedo": 0.0, "phase": {"type": "isotropic"}}
 
 
 def _camera(position, look_at, up=(0.0, 1.0, 0.0), fov_y=60.0) -> dict[str, Any]:
@@ -79,7 +84,7 @@ SCENES: dict[str, dict[str, Any]] = {
         _camera((0, 3, 4), (0, 0, -10)),
         [_light((2, 4, -5), [100, 100, 100], 0.1), _light((-3, 3, -18), [200, 200, 200], 0.1)],
         [_plane(albedo=0.5), _box((-1, 0, -9), (1, 3, -7), 0.7), _sphere((4, 1, -12), 1.0, 0.6)],
-        medium={"sigma_t": [0.01, 0.05, 0.2], "albedo": 0.9, "phase": {"type": "isotropic"}},
+        medium={"sigma_t": [0.01, 0.05, 0.2], "albedo": 0.0, "phase": {"type": "isotropic"}},
     ),
     "no_medium": _scene(
         _camera((0, 3, 4), (0, 0, -10)),
@@ -108,7 +113,7 @@ SCENES: dict[str, dict[str, Any]] = {
         _camera((0, 0.05, 0), (0, 0.0, -10), fov_y=20.0),
         [_light((1, 2, -15), [200, 200, 200], 0.1), _light((-2, 0.5, -40), [300, 250, 200], 0.1)],
         [_plane(albedo=0.5), _box((1, 0, -30), (3, 0.4, -28), 0.7)],
-        medium={"sigma_t": 0.02, "albedo": 1.0},
+        medium={"sigma_t": 0.02, "albedo": 0.0},
     ),
     "grazing_light_and_rolled_camera": _scene(
         _camera((1, 2, 3), (-1, 0.2, -5), up=(0.4, 1.0, 0.1), fov_y=50.0),
@@ -189,3 +194,37 @@ def test_inside_lamp_scene_has_floor_points_within_the_lamp_radius() -> None:
     inside = np.linalg.norm(points - np.array(lamp["position"]), axis=-1) < lamp["radius"]
     floor = ref_image.smooth_mask() & (ref_image.hit_id == 0)
     assert (inside & floor).sum() >= 2000
+
+
+def _scaled(scene: dict[str, Any], k: float) -> dict[str, Any]:
+    """The same scene with every length multiplied by k, intensities by k^2 and
+    extinction divided by k: every pixel's radiance is unchanged."""
+    s = copy.deepcopy(scene)
+    for key in ("position", "look_at"):
+        s["camera"][key] = [x * k for x in s["camera"][key]]
+    for light in s["lights"]:
+        light["position"] = [x * k for x in light["position"]]
+        light["radius"] *= k
+        light["intensity"] = (np.asarray(light["intensity"], dtype=np.float64) * k * k).tolist()
+    for surface in s["surfaces"]:
+        for key in ("point", "min", "max", "center"):
+            if key in surface:
+                surface[key] = [x * k for x in surface[key]]
+        if "radius" in surface:
+            surface["radius"] *= k
+    if s.get("medium") is not None:
+        s["medium"]["sigma_t"] = (np.asarray(s["medium"]["sigma_t"], dtype=np.float64) / k).tolist()
+    return s
+
+
+@pytest.mark.parametrize("scale", [1e-3, 1e3])
+@pytest.mark.parametrize("name", ["plane_and_boxes_with_shadows", "spheres_on_plane"])
+def test_direct_lighting_is_independent_of_the_scene_scale(
+        name: str, scale: float, renderer: airlight.Renderer) -> None:
+    """Millimetre and kilometre versions of a scene render like the metre one
+    (shadow-ray offsets and tolerances must follow the scene's scale)."""
+    scene = _scaled(SCENES[name], scale)
+    ref_image = render_reference(scene)
+    np.testing.assert_allclose(ref_image.radiance, render_reference(SCENES[name]).radiance, rtol=1e-9, atol=0)
+    tested = _compare(renderer.render(scene), ref_image, f"{name} x{scale:g} [{renderer.backend}]")
+    assert tested >= MIN_TESTED

@@ -176,7 +176,7 @@ def test_non_dict_scene_is_a_type_error(scene) -> None:
         airlight.render(scene, backend="cpu")
 
 
-def test_json_text_that_is_not_an_object_is_a_type_error() -> None:
+def test_invalid_json_text_is_a_value_error() -> None:
     # Text starting with "{" is JSON; a JSON list is read from a file to test it.
     with pytest.raises(ValueError, match="invalid JSON"):
         airlight.load_scene("{not json")
