@@ -10,6 +10,7 @@
 #include <pybind11/pybind11.h>
 
 #include <cstring>
+#include <limits>
 #include <memory>
 
 namespace py = pybind11;
@@ -19,27 +20,46 @@ namespace {
 
 // Python value -> JSON value. Unsupported types become a TypeError naming the
 // path, so that e.g. a set inside the scene is reported, not crashed on.
+std::string type_name_of(py::handle obj) { return py::str(py::type::of(obj).attr("__name__")); }
+
+std::string field_name(const std::string& path) { return path.empty() ? std::string("scene") : path; }
+
+// UTF-8 of a Python str; strings that cannot be encoded (lone surrogates)
+// are a ValueError naming the field.
+std::string utf8(py::handle obj, const std::string& path) {
+    Py_ssize_t size = 0;
+    const char* data = PyUnicode_AsUTF8AndSize(obj.ptr(), &size);
+    if (data == nullptr) {
+        PyErr_Clear();
+        throw py::value_error(field_name(path) + ": string is not valid Unicode");
+    }
+    return std::string(data, size_t(size));
+}
+
 nlohmann::json to_json(py::handle obj, const std::string& path, int depth = 0) {
-    if (depth > 64) throw py::value_error(path + ": nesting too deep");
+    if (depth > 64) throw py::value_error(field_name(path) + ": nesting too deep");
     if (obj.is_none()) return nullptr;
     if (py::isinstance<py::bool_>(obj)) return obj.cast<bool>();
+    if (py::hasattr(obj, "dtype") && py::hasattr(obj, "ndim") && obj.attr("ndim").cast<int>() == 0) {
+        // numpy scalars and 0-d arrays: their Python value (np.bool_ stays a bool).
+        return to_json(obj.attr("item")(), path, depth + 1);
+    }
     if (py::isinstance<py::int_>(obj)) {
-        try {
-            return obj.cast<long long>();
-        } catch (const py::cast_error&) {
-            return obj.cast<double>();  // huge integers: let the range checks speak
-        }
+        int overflow = 0;
+        const long long value = PyLong_AsLongLongAndOverflow(obj.ptr(), &overflow);
+        if (overflow == 0) return value;
+        // Beyond 64 bits: an infinite number, which the validator rejects by name.
+        return overflow > 0 ? std::numeric_limits<double>::infinity() : -std::numeric_limits<double>::infinity();
     }
     if (py::isinstance<py::float_>(obj)) return obj.cast<double>();
-    if (py::isinstance<py::str>(obj)) return obj.cast<std::string>();
+    if (py::isinstance<py::str>(obj)) return utf8(obj, path);
     if (py::isinstance<py::dict>(obj)) {
         nlohmann::json out = nlohmann::json::object();
         for (auto item : py::reinterpret_borrow<py::dict>(obj)) {
             if (!py::isinstance<py::str>(item.first)) {
-                throw py::type_error(path + ": keys must be strings, got " +
-                                     std::string(py::str(py::type::of(item.first).attr("__name__"))));
+                throw py::type_error(field_name(path) + ": keys must be strings, got " + type_name_of(item.first));
             }
-            const std::string key = item.first.cast<std::string>();
+            const std::string key = utf8(item.first, path);
             out[key] = to_json(item.second, path.empty() ? key : path + "." + key, depth + 1);
         }
         return out;
@@ -47,18 +67,13 @@ nlohmann::json to_json(py::handle obj, const std::string& path, int depth = 0) {
     if (py::isinstance<py::list>(obj) || py::isinstance<py::tuple>(obj) || py::isinstance<py::array>(obj)) {
         py::sequence seq = py::isinstance<py::array>(obj) ? py::sequence(obj.attr("tolist")())
                                                           : py::reinterpret_borrow<py::sequence>(obj);
-        if (!py::isinstance<py::sequence>(seq)) return to_json(seq, path, depth + 1);  // 0-d array
         nlohmann::json out = nlohmann::json::array();
         for (size_t i = 0; i < seq.size(); ++i) {
             out.push_back(to_json(seq[i], path + "[" + std::to_string(i) + "]", depth + 1));
         }
         return out;
     }
-    // numpy scalars and other number-likes.
-    if (py::hasattr(obj, "__index__")) return obj.attr("__index__")().cast<long long>();
-    if (py::hasattr(obj, "__float__") && !py::isinstance<py::str>(obj)) return obj.attr("__float__")().cast<double>();
-    throw py::type_error((path.empty() ? std::string("scene") : path) + ": unsupported type " +
-                         std::string(py::str(py::type::of(obj).attr("__name__"))));
+    throw py::type_error(field_name(path) + ": unsupported type " + type_name_of(obj));
 }
 
 Scene scene_from_python(py::handle obj) {
@@ -94,8 +109,7 @@ PYBIND11_MODULE(_core, m) {
                             e.what());
         }
     });
-    static py::exception<airlight::BackendUnavailable> backend_unavailable(m, "BackendUnavailableError",
-                                                                          PyExc_RuntimeError);
+    py::register_exception<airlight::BackendUnavailable>(m, "BackendUnavailableError", PyExc_RuntimeError);
 
     m.def("validate_scene", [](py::handle scene) { return airlight::scene_to_json(scene_from_python(scene), -1); },
           "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");

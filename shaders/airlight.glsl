@@ -74,17 +74,16 @@ float airlight_segment(float sigma, float b, float h, float x0, float x1) {
 // log G(T, theta_s) from the table (it stores log G: interpolating the
 // logarithm keeps the relative error even where G varies like log(T) / T).
 float surface_glow_log_lookup(float optical_distance, float cos_theta_s, int nx, int ny) {
+    float T = min(optical_distance, SURFACE_GLOW_T_MAX);
     float c = clamp(cos_theta_s, -1.0f, 1.0f);
-    float k = max(optical_distance, 1.0e-4f);
+    float k = max(T, 1.0e-4f);
     float Y = 0.5f + 0.5f * asinh(k * c) / asinh(k);
-    float X = sqrt(log(1.0f + optical_distance / SURFACE_GLOW_T_SCALE) /
-                   log(1.0f + SURFACE_GLOW_T_MAX / SURFACE_GLOW_T_SCALE));
+    float X = sqrt(log(1.0f + T / SURFACE_GLOW_T_SCALE) / log(1.0f + SURFACE_GLOW_T_MAX / SURFACE_GLOW_T_SCALE));
     return table_bilinear(TABLE_SURFACE_GLOW, nx, ny, X, Y);
 }
 
 // G0(T, theta_s) = e^{-T} G(T, theta_s).
 float surface_glow(float optical_distance, float cos_theta_s) {
-    if (optical_distance >= SURFACE_GLOW_T_MAX) return 0.0f;
     return exp(surface_glow_log_lookup(optical_distance, cos_theta_s, SURFACE_GLOW_NX, SURFACE_GLOW_NY) -
                optical_distance);
 }

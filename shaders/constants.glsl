@@ -16,11 +16,13 @@ CONST int AIRLIGHT_TAIL_NY = 64;
 
 // Surface glow G(T, theta_s) = e^{T} G0(T, theta_s) (MODELS.md section 1,
 // "surfaces lit through fog"), X = sqrt(T / T_max), Y warped in cos theta_s
-// (surface_glow() in airlight.glsl). Beyond
-// T_max the factor e^{-T} < 1e-43 makes the glow exactly 0 in float32.
+// (surface_glow() in airlight.glsl). The factor e^{-T} G underflows float32
+// gradually (denormals) from T ~ 90 and is exactly 0 long before T_max, so
+// the glow goes continuously to 0 inside the table; past T_max the lookup is
+// clamped to the last column (of no consequence: e^{-200} = 0 in float32).
 CONST int TABLE_SURFACE_GLOW = 1;
 CONST int SURFACE_GLOW_NX = 256;
 CONST int SURFACE_GLOW_NY = 128;
-CONST float SURFACE_GLOW_T_MAX = 88.0f;
+CONST float SURFACE_GLOW_T_MAX = 200.0f;
 CONST float SURFACE_GLOW_T_SCALE = 0.05f;
 

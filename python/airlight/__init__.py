@@ -64,6 +64,8 @@ def _scene_source(scene: SceneLike) -> Any:
             return Path(text).read_text(encoding="utf-8")
         except OSError as exc:
             raise ValueError(f"path: cannot read scene file {text!r}: {exc.strerror}") from None
+        except (ValueError, UnicodeError) as exc:  # embedded NUL, undecodable bytes
+            raise ValueError(f"path: cannot read scene file {text!r}: {exc}") from None
     raise TypeError(f"scene: expected a dict, a path or JSON text, got {type(scene).__name__}")
 
 
