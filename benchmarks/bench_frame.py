@@ -37,8 +37,10 @@ def time_backend(backend: str, scene: dict, frames: int) -> dict[str, float]:
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    parser.add_argument("--scene", default=str(Path(__file__).resolve().parents[1] / "scenes" / "default.json"))
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
+    default_scene = Path(__file__).resolve().parents[1] / "scenes" / "default.json"
+    parser.add_argument("--scene", default=str(default_scene))
     parser.add_argument("--frames", type=int, default=10)
     parser.add_argument("--width", type=int, default=640)
     parser.add_argument("--height", type=int, default=360)

@@ -21,7 +21,7 @@ import os
 import warnings
 from collections.abc import Mapping
 from pathlib import Path
-from typing import Any, Optional, Union
+from typing import Any, Union
 
 import numpy as np
 
@@ -78,7 +78,7 @@ def load_scene(scene: SceneLike) -> dict[str, Any]:
     return json.loads(_core.validate_scene(_scene_source(scene)))
 
 
-def _with_film_size(scene: SceneLike, width: Optional[int], height: Optional[int]) -> Any:
+def _with_film_size(scene: SceneLike, width: int | None, height: int | None) -> Any:
     source = _scene_source(scene)
     if width is None and height is None:
         return source
@@ -93,7 +93,7 @@ def _with_film_size(scene: SceneLike, width: Optional[int], height: Optional[int
     return data
 
 
-def gl_unavailable_reason() -> Optional[str]:
+def gl_unavailable_reason() -> str | None:
     """None when the GL backend can run here, else the reason it cannot."""
     ok, reason = _core.gl_backend_available()
     return None if ok else reason
@@ -131,7 +131,7 @@ class Renderer:
                     _warned_fallback = True
         if not isinstance(cpu_threads, int) or cpu_threads < 0:
             raise ValueError(f"cpu_threads: must be an integer >= 0, got {cpu_threads!r}")
-        self._native: Optional[_core.Renderer] = _core.Renderer(backend)
+        self._native: _core.Renderer | None = _core.Renderer(backend)
         self._native.set_cpu_threads(cpu_threads)
 
     @property
@@ -144,8 +144,8 @@ class Renderer:
             raise RuntimeError("Renderer is closed")
         return self._native
 
-    def render(self, scene: SceneLike, *, width: Optional[int] = None,
-               height: Optional[int] = None) -> np.ndarray:
+    def render(self, scene: SceneLike, *, width: int | None = None,
+               height: int | None = None) -> np.ndarray:
         """Linear radiance of ``scene``: float32 array (height, width, 3), row 0
         on top. ``width``/``height`` override the scene's film size."""
         return self._active().render(_with_film_size(scene, width, height))
@@ -161,8 +161,8 @@ class Renderer:
         self.close()
 
 
-def render(scene: SceneLike, backend: str = "auto", *, width: Optional[int] = None,
-           height: Optional[int] = None) -> np.ndarray:
+def render(scene: SceneLike, backend: str = "auto", *, width: int | None = None,
+           height: int | None = None) -> np.ndarray:
     """Renders one frame; see :class:`Renderer` (which is faster for many frames)."""
     with Renderer(backend) as renderer:
         return renderer.render(scene, width=width, height=height)
@@ -175,19 +175,19 @@ def to_srgb8(radiance: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     return _core.to_srgb8(np.asarray(radiance, dtype=np.float32), float(exposure))
 
 
-def save_png(path: Union[str, os.PathLike[str]], radiance: np.ndarray, exposure: float = 1.0) -> None:
+def save_png(path: str | os.PathLike[str], radiance: np.ndarray, exposure: float = 1.0) -> None:
     """Writes ``radiance * exposure`` as an 8-bit sRGB PNG (through Pillow)."""
     from PIL import Image
 
     Image.fromarray(to_srgb8(radiance, exposure), mode="RGB").save(os.fspath(path), format="PNG")
 
 
-def save_pfm(path: Union[str, os.PathLike[str]], radiance: np.ndarray) -> None:
+def save_pfm(path: str | os.PathLike[str], radiance: np.ndarray) -> None:
     """Writes linear radiance as a portable float map (HDR, little-endian)."""
     _core.write_pfm(os.fspath(path), np.asarray(radiance, dtype=np.float32))
 
 
-def load_pfm(path: Union[str, os.PathLike[str]]) -> np.ndarray:
+def load_pfm(path: str | os.PathLike[str]) -> np.ndarray:
     """Reads a colour portable float map into a float32 (height, width, 3) array, row 0 on top."""
     with open(path, "rb") as f:
         if f.readline().strip() != b"PF":
