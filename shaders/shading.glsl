@@ -147,7 +147,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         vec3 p = origin + t_hit * dir;
         vec3 albedo = vec3(surface(hit_index).albedo_type);
         vec3 irradiance = vec3(0.0f);
-        if (HAS_POINT_LIGHTS) irradiance += point_light_irradiance(p, normal);
+        // A black surface reflects nothing: skip its lighting (and shadow rays).
+        bool black = albedo.x == 0.0f && albedo.y == 0.0f && albedo.z == 0.0f;
+        if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal);
         radiance = albedo / PI * irradiance;
     } else {
         radiance = vec3(frame.background);
