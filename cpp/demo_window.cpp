@@ -55,6 +55,8 @@ int run_window(Scene scene, Backend backend, float exposure) {
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
+    // EGL, like the GL backend: GLX and EGL contexts cannot take turns on one thread.
+    glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
     GLFWwindow* window = glfwCreateWindow(scene.film.width, scene.film.height, "airlight", nullptr, nullptr);
     if (window == nullptr) {
         glfwTerminate();
