@@ -5,6 +5,7 @@
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
 #include "scene_json.hpp"
+#include "tables.hpp"
 
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
@@ -132,6 +133,18 @@ PYBIND11_MODULE(_core, m) {
         return out;
     });
 
+    m.def("tables_built", []() {
+        py::dict out;
+        for (const airlight::TableInfo& info : airlight::tables_built()) {
+            py::dict d;
+            d["width"] = info.table->width;
+            d["height"] = info.table->height;
+            d["bytes"] = info.table->texels.size() * sizeof(float);
+            d["build_seconds"] = info.table->build_seconds;
+            out[info.name] = d;
+        }
+        return out;
+    });
     m.def("write_pfm", [](const std::string& path,
                           const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
         airlight::write_pfm(path, image_from_numpy(radiance));

@@ -2,7 +2,6 @@
 
 #include "shader_cpp.hpp"
 
-#include <atomic>
 #include <chrono>
 #include <algorithm>
 #include <cmath>
@@ -17,7 +16,11 @@ using cdouble = std::complex<double>;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kEulerGamma = 0.57721566490153286061;
 
-std::atomic<int> built_count{0};
+std::mutex registry_mutex;
+std::vector<TableInfo>& registry() {
+    static std::vector<TableInfo> tables;
+    return tables;
+}
 
 // e^w E1(w) for Re w >= 0: power series for |w| < 3.5, else the even
 // continued fraction e^w E1(w) = 1 / (w + 1 - 1^2 / (w + 3 - 2^2 / (w + 5 - ...))).
@@ -54,12 +57,18 @@ double clamped_cosine_ring(double g, double theta_s) {
 }
 
 template <class Build>
-Table2D timed_build(Build build) {
+Table2D timed_build(const char* name, Build build) {
     const auto start = std::chrono::steady_clock::now();
     Table2D table = build();
+    table.name = name;
     table.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    ++built_count;
     return table;
+}
+
+bool register_table(const Table2D& table) {
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    registry().push_back({table.name, &table});
+    return true;
 }
 
 // Quadrature nodes in g in [0, pi] for the glow integral: panels graded
@@ -111,7 +120,7 @@ double surface_glow_exact(double optical_distance, double theta_s, int nodes_sca
 }
 
 const Table2D& airlight_tail_table() {
-    static const Table2D table = timed_build([] {
+    static const Table2D table = timed_build("airlight_tail", [] {
         using namespace shader;
         Table2D t;
         t.width = AIRLIGHT_TAIL_NX;
@@ -138,13 +147,17 @@ const Table2D& airlight_tail_table() {
         }
         return t;
     });
+    static const bool registered = register_table(table);
+    (void)registered;
     return table;
 }
 
 const Table2D& surface_glow_table() {
-    static const Table2D table = timed_build([] {
+    static const Table2D table = timed_build("surface_glow", [] {
         return build_surface_glow_table(shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY);
     });
+    static const bool registered = register_table(table);
+    (void)registered;
     return table;
 }
 
@@ -178,6 +191,9 @@ Table2D build_surface_glow_table(int width, int height) {
         return t;
 }
 
-int tables_built() { return built_count.load(); }
+std::vector<TableInfo> tables_built() {
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    return registry();
+}
 
 }  // namespace airlight

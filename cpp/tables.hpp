@@ -10,6 +10,7 @@ namespace airlight {
 // A grid of float32 texels, row-major: texels[y * width + x]; node-aligned
 // (texel i sits at the normalised coordinate i / (width - 1)).
 struct Table2D {
+    const char* name = "";
     int width = 0;
     int height = 0;
     std::vector<float> texels;
@@ -39,8 +40,12 @@ Table2D build_surface_glow_table(int width, int height);
 const Table2D& airlight_tail_table();
 const Table2D& surface_glow_table();
 
-// Number of tables built so far in this process (for tests showing that a
-// scene which does not need them builds none).
-int tables_built();
+// The tables built so far in this process, by name (for tests showing that a
+// scene which does not need a table builds none, and for reporting memory).
+struct TableInfo {
+    const char* name;
+    const Table2D* table;
+};
+std::vector<TableInfo> tables_built();
 
 }  // namespace airlight

@@ -41,6 +41,7 @@ __all__ = [
     "render",
     "save_pfm",
     "save_png",
+    "table_stats",
     "to_srgb8",
 ]
 
@@ -197,6 +198,13 @@ def load_pfm(path: str | os.PathLike[str]) -> np.ndarray:
         dtype = "<f4" if scale < 0 else ">f4"
         data = np.frombuffer(f.read(width * height * 12), dtype=dtype).reshape(height, width, 3)
     return data[::-1].astype(np.float32)
+
+
+def table_stats() -> dict[str, dict[str, Any]]:
+    """The scattering tables built so far in this process (each is built once, on
+    first need): name -> width, height, bytes, build_seconds. Empty until a scene
+    with lamps in a scattering medium is rendered."""
+    return dict(_core.tables_built())
 
 
 def preset_names() -> list[str]:
