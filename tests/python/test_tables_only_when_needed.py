@@ -1,0 +1,65 @@
+"""A table that no effect uses is never built: scenes without lamps, or without a
+scattering medium, build no scattering table; a scene with lamps in fog builds each
+table once per process, and a second frame builds nothing new. Each case runs in a
+fresh interpreter, because tables live for the whole process."""
+
+from __future__ import annotations
+
+import json
+import subprocess
+import sys
+import textwrap
+
+import pytest
+
+SCRIPT = textwrap.dedent("""
+    import json, sys, airlight
+    scenes = json.loads(sys.argv[1])
+    seen = []
+    for scene in scenes:
+        airlight.render(scene, backend="cpu")
+        seen.append(sorted(airlight.table_stats()))
+    print(json.dumps({"seen": seen, "stats": airlight.table_stats()}))
+""")
+
+
+def base(**extra: object) -> dict:
+    scene = {"film": {"width": 16, "height": 12},
+             "camera": {"position": [0, 1.7, 0], "look_at": [0, 1.7, -10], "up": [0, 1, 0], "fov_y": 60},
+             "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]}
+    scene.update(extra)
+    return scene
+
+
+LAMP = [{"type": "point", "position": [2, 5, -10], "intensity": 100}]
+FOG = {"sigma_t": 0.05, "albedo": 0.9}
+
+
+def run(scenes: list[dict]) -> dict:
+    out = subprocess.run([sys.executable, "-c", SCRIPT, json.dumps(scenes)], capture_output=True, text=True,
+                         check=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("scene", [
+    base(),                                              # nothing at all
+    base(medium=FOG),                                    # fog, no lamps
+    base(lights=LAMP),                                   # lamps in clear air
+    base(lights=LAMP, medium={"sigma_t": 0.05, "albedo": 0}),  # lamps in purely absorbing fog
+], ids=["empty", "fog_without_lamps", "lamps_without_fog", "absorbing_fog"])
+def test_scene_without_scattering_lamps_builds_no_table(scene):
+    assert run([scene])["seen"] == [[]]
+
+
+def test_lamps_in_fog_build_each_table_once():
+    scene = base(lights=LAMP, medium=FOG)
+    result = run([scene, scene, base(lights=LAMP * 3, medium=FOG)])
+    assert result["seen"] == [["airlight_tail", "surface_glow"]] * 3
+    stats = result["stats"]
+    assert stats["airlight_tail"]["bytes"] == 256 * 64 * 4
+    assert stats["surface_glow"]["bytes"] == 256 * 128 * 4
+
+
+def test_ray_marched_airlight_builds_no_tail_table():
+    scene = base(lights=LAMP, medium=FOG, quality={"airlight": "march", "march_steps": 16})
+    assert run([scene])["seen"] == [["surface_glow"]]
