@@ -82,8 +82,11 @@ float surface_glow_log_lookup(float optical_distance, float cos_theta_s, int nx,
     return table_bilinear(TABLE_SURFACE_GLOW, nx, ny, X, Y);
 }
 
-// G0(T, theta_s) = e^{-T} G(T, theta_s).
-float surface_glow(float optical_distance, float cos_theta_s) {
+// scale e^{-T} G(T, theta_s) = scale G0(T, theta_s), for scale >= 0, as one
+// exponential: the product stays exact where e^{-T} G alone would be a
+// denormal that a GPU flushes to zero (huge intensities at large T).
+float scaled_surface_glow(float scale, float optical_distance, float cos_theta_s) {
+    if (scale <= 0.0f) return 0.0f;
     return exp(surface_glow_log_lookup(optical_distance, cos_theta_s, SURFACE_GLOW_NX, SURFACE_GLOW_NY) -
-               optical_distance);
+               optical_distance + log(scale));
 }

@@ -23,19 +23,20 @@ float surface_offset(vec3 p) {
     return 1.0e-5f * scale + 1.0e-30f;
 }
 
-// Light scattered once on its way from a lamp to a surface point at distance
-// dist, per unit intensity: sigma_s / (2 pi D) e^{-T} G(T, theta_s)
+// Irradiance from the light of a lamp of intensity I scattered once on its way
+// to a surface point at distance dist: sigma_s I / (2 pi D) e^{-T} G(T, theta_s)
 // (MODELS.md section 1, G0 term), D held at the lamp radius inside the lamp.
-vec3 surface_glow_per_intensity(float dist, float radius, float cos_theta_s) {
+vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos_theta_s) {
     vec3 sigma_t = vec3(frame.sigma_t);
-    vec3 glow;
+    vec3 scale = vec3(frame.sigma_s) * intensity / (2.0f * PI * max(dist, radius));
     if (GREY_MEDIUM) {
-        glow = vec3(surface_glow(sigma_t.x * dist, cos_theta_s));
-    } else {
-        glow = vec3(surface_glow(sigma_t.x * dist, cos_theta_s), surface_glow(sigma_t.y * dist, cos_theta_s),
-                    surface_glow(sigma_t.z * dist, cos_theta_s));
+        // sigma equal on all channels: one lookup, the channels differ by I only.
+        float peak = max(max(scale.x, scale.y), scale.z);
+        return peak > 0.0f ? (scale / peak) * scaled_surface_glow(peak, sigma_t.x * dist, cos_theta_s) : vec3(0.0f);
     }
-    return vec3(frame.sigma_s) * glow / (2.0f * PI * max(dist, radius));
+    return vec3(scaled_surface_glow(scale.x, sigma_t.x * dist, cos_theta_s),
+                scaled_surface_glow(scale.y, sigma_t.y * dist, cos_theta_s),
+                scaled_surface_glow(scale.z, sigma_t.z * dist, cos_theta_s));
 }
 
 // True when a contribution bounded by `bound` is provably below the culling
@@ -69,7 +70,7 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         vec3 glow_bound = vec3(0.0f);
         if (HAS_AIRLIGHT) glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (frame.quality.w / (2.0f * PI * max(dist, radius)));
         if (negligible(direct + glow_bound, irradiance)) continue;
-        if (HAS_AIRLIGHT) irradiance += intensity * surface_glow_per_intensity(dist, radius, cos_theta);
+        if (HAS_AIRLIGHT) irradiance += surface_glow_irradiance(intensity, dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
         irradiance += direct;

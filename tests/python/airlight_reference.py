@@ -527,8 +527,9 @@ _RENDERERS: dict[str, Any] = {}
 def get_renderer(backend: str) -> Any:
     """One airlight.Renderer per backend, shared by the test_airlight_* files; skips
     the calling test where the backend cannot run."""
-    import airlight
     import pytest
+
+    import airlight
 
     if backend == "gl":
         reason = airlight.gl_unavailable_reason()

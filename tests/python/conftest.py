@@ -5,8 +5,9 @@ from __future__ import annotations
 import copy
 from typing import Any, Callable
 
-import airlight
 import pytest
+
+import airlight
 
 BACKENDS = ("cpu", "gl")
 

@@ -8,9 +8,10 @@ import subprocess
 import sys
 import textwrap
 
-import airlight
 import numpy as np
 import pytest
+
+import airlight
 
 
 def _run_python(code: str, **env: str) -> subprocess.CompletedProcess:

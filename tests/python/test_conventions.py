@@ -6,9 +6,10 @@ from __future__ import annotations
 import math
 from typing import Any
 
-import airlight
 import numpy as np
 import pytest
+
+import airlight
 
 
 def _camera(fov_y: float = 60.0) -> dict[str, Any]:

@@ -10,10 +10,11 @@ from __future__ import annotations
 import copy
 from typing import Any
 
-import airlight
 import numpy as np
 import pytest
 from reference import BACKGROUND_ID, LAMP_ID_BASE, camera_rays, render_reference
+
+import airlight
 
 WIDTH, HEIGHT = 160, 120
 REL_TOL = 5e-3

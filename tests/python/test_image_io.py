@@ -7,10 +7,11 @@ import subprocess
 import sys
 from pathlib import Path
 
-import airlight
 import numpy as np
 import pytest
 from PIL import Image
+
+import airlight
 
 DEMO = Path(sys.executable).with_name("airlight-demo")
 

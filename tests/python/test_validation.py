@@ -9,11 +9,12 @@ import math
 import re
 from typing import Any, Callable
 
-import airlight
 import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
+
+import airlight
 
 VALID: dict[str, Any] = {
     "film": {"width": 24, "height": 16},
