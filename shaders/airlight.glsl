@@ -23,11 +23,13 @@ float table_bilinear(int table, int nx, int ny, float X, float Y) {
 // Geometry of one light relative to the ray o + x d: b = (S - o).d is the
 // distance along the ray to the closest approach, h > 0 the closest distance.
 
-// exp(-sigma (x + d(x))) Q(u, xi(x)): the airlight integral from ray point x
-// to infinity in units of sigma_s I / (2 pi h), with d(x) the point-light
-// distance and xi(x) = 1/2 atan2(h, b - x) (MODELS.md section 1). Every factor
-// is <= 1, so nothing overflows however thick the fog.
-float airlight_tail(float sigma, float b, float h, float x) {
+// scale exp(-sigma (x + d(x))) Q(u, xi(x)): the airlight integral from ray
+// point x to infinity in units of sigma_s I / (2 pi h) (times `scale`, passed
+// as log_scale and folded into the exponential so that a huge intensity times
+// a tiny attenuation never passes through a float32 denormal), with d(x) the
+// point-light distance and xi(x) = 1/2 atan2(h, b - x) (MODELS.md section 1).
+// exp(-sigma (x + d)) <= 1, so nothing overflows however thick the fog.
+float airlight_tail(float sigma, float b, float h, float x, float log_scale) {
     float xb = x - b;
     float d = sqrt(h * h + xb * xb);
     float p = xb >= 0.0f ? d + xb : h * h / (d - xb);  // d + x - b, no cancellation
@@ -37,17 +39,17 @@ float airlight_tail(float sigma, float b, float h, float x) {
     float S = table_bilinear(TABLE_AIRLIGHT_TAIL, AIRLIGHT_TAIL_NX, AIRLIGHT_TAIL_NY, sqrt(z / (1.0f + z)),
                              1.0f - cv * (2.0f / PI));
     float N = cv / (1.0f + 2.0f * sigma * d * tan_xi * cv);  // u sec^2 xi = 2 sigma d tan xi
-    return exp(-sigma * (x + d)) * N * S;
+    return exp(log_scale - sigma * (x + d)) * N * S;
 }
 
 // Airlight integral over the ray segment [x0, x1] (x1 = NO_HIT: to infinity)
-// in units of sigma_s I / (2 pi h): the difference of two tails, or, when
-// that difference would cancel (tail(x1) > tail(x0) / 2), 3-point
-// Gauss-Legendre of the integrand exp(-u (tan xi - tan xi0)) in xi.
-float airlight_segment(float sigma, float b, float h, float x0, float x1) {
-    float tail0 = airlight_tail(sigma, b, h, x0);
+// in units of sigma_s I / (2 pi h), times exp(log_scale): the difference of
+// two tails, or, when that difference would cancel (tail(x1) > tail(x0) / 2),
+// 3-point Gauss-Legendre of the integrand exp(-u (tan xi - tan xi0)) in xi.
+float airlight_segment(float sigma, float b, float h, float x0, float x1, float log_scale) {
+    float tail0 = airlight_tail(sigma, b, h, x0, log_scale);
     if (x1 >= NO_HIT) return tail0;
-    float tail1 = airlight_tail(sigma, b, h, x1);
+    float tail1 = airlight_tail(sigma, b, h, x1, log_scale);
     if (tail1 <= 0.5f * tail0) return tail0 - tail1;
     float xb0 = x0 - b;
     float cv0 = 0.5f * atan(h, xb0);
@@ -62,7 +64,7 @@ float airlight_segment(float sigma, float b, float h, float x0, float x1) {
                 (8.0f / 18.0f) * exp(-u * sin(e1) / (s0 * sin(cv0 - e1))) +
                 (5.0f / 18.0f) * exp(-u * sin(e2) / (s0 * sin(cv0 - e2)));
     float d0 = sqrt(h * h + xb0 * xb0);
-    return exp(-sigma * (x0 + d0)) * sum * dv;
+    return exp(log_scale - sigma * (x0 + d0)) * sum * dv;
 }
 
 // ---- Light scattered onto surfaces ----------------------------------------

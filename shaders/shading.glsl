@@ -115,9 +115,15 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
     if (negligible(scale * (0.5f * PI) * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
     if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), origin, dir, x0, x_end);
-    if (GREY_MEDIUM) return scale * airlight_segment(sigma_t.x, b, h, x0, x_end);
-    return scale * vec3(airlight_segment(sigma_t.x, b, h, x0, x_end), airlight_segment(sigma_t.y, b, h, x0, x_end),
-                        airlight_segment(sigma_t.z, b, h, x0, x_end));
+    // The scale goes into the exponent (airlight_tail); channels without
+    // scattering or light have none.
+    if (GREY_MEDIUM) {
+        float peak = max(max(scale.x, scale.y), scale.z);
+        return peak > 0.0f ? (scale / peak) * airlight_segment(sigma_t.x, b, h, x0, x_end, log(peak)) : vec3(0.0f);
+    }
+    return vec3(scale.x > 0.0f ? airlight_segment(sigma_t.x, b, h, x0, x_end, log(scale.x)) : 0.0f,
+                scale.y > 0.0f ? airlight_segment(sigma_t.y, b, h, x0, x_end, log(scale.y)) : 0.0f,
+                scale.z > 0.0f ? airlight_segment(sigma_t.z, b, h, x0, x_end, log(scale.z)) : 0.0f);
 }
 
 // Radiance arriving at the camera along the ray origin + t dir.
