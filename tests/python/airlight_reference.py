@@ -39,6 +39,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from reference import _INTERSECT as _REFERENCE_INTERSECT
 from scipy.integrate import IntegrationWarning, quad
 
 DEFAULT_LAMP_RADIUS = 0.05
@@ -159,41 +160,11 @@ def camera_rays(sc: Scene, rows: np.ndarray | None = None,
 # ---- intersections (vectorised over rays) --------------------------------------------------
 
 def _intersect(s: Surface, o: np.ndarray, d: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
-    """Nearest t > 0 (inf if none), face index and geometric normal of rays o + t d."""
-    n = len(d)
-    if s.kind == "plane":
-        denom = d @ s.b
-        with np.errstate(divide="ignore", invalid="ignore"):
-            t = ((s.a - o) @ s.b) / denom
-        t = np.where((denom != 0) & (t > 0), t, np.inf)
-        return t, np.zeros(n, dtype=np.int64), np.broadcast_to(s.b, (n, 3)).copy()
-    if s.kind == "box":
-        with np.errstate(divide="ignore", invalid="ignore"):
-            ta = (s.a - o) / d
-            tb = (s.b - o) / d
-        parallel = d == 0
-        inside = (o >= s.a) & (o <= s.b)
-        lo = np.where(parallel, np.where(inside, -np.inf, np.inf), np.minimum(ta, tb))
-        hi = np.where(parallel, np.where(inside, np.inf, -np.inf), np.maximum(ta, tb))
-        t_near, t_far = lo.max(axis=1), hi.min(axis=1)
-        entering = t_near > 0
-        t = np.where(entering, t_near, t_far)
-        hit = (t_near <= t_far) & (t > 0)
-        axis = np.where(entering, lo.argmax(axis=1), hi.argmin(axis=1))
-        idx = np.arange(n)
-        normal = np.zeros((n, 3))
-        normal[idx, axis] = 1.0
-        face = axis * 2 + (d[idx, axis] > 0)
-        return np.where(hit, t, np.inf), face, normal
-    oc = o - s.a
-    b = np.einsum("ij,ij->i", oc, d)
-    c = np.einsum("ij,ij->i", oc, oc) - s.radius ** 2
-    disc = b * b - c
-    root = np.sqrt(np.maximum(disc, 0.0))
-    t0, t1 = -b - root, -b + root
-    t = np.where(disc >= 0, np.where(t0 > 0, t0, np.where(t1 > 0, t1, np.inf)), np.inf)
-    p = o + np.where(np.isfinite(t), t, 0.0)[:, None] * d
-    return t, np.zeros(n, dtype=np.int64), (p - s.a) / s.radius
+    """Nearest t > 0 (inf if none), face index and geometric normal of rays o + t d:
+    the foundation reference's intersection routines (same surface fields)."""
+    o = np.broadcast_to(np.asarray(o, dtype=np.float64), d.shape)
+    t, face, normal = _REFERENCE_INTERSECT[s.kind](s, o, d)
+    return t, face, np.array(normal, dtype=np.float64)
 
 
 def lamp_entry(light: Light, o: np.ndarray, d: np.ndarray) -> np.ndarray:
