@@ -2,11 +2,11 @@
 // the same shared per-pixel code (shaders/*.glsl).
 #pragma once
 
-#include "airlight/renderer.hpp"
-#include "frame_data.hpp"
-
 #include <memory>
 #include <string>
+
+#include "airlight/renderer.hpp"
+#include "frame_data.hpp"
 
 namespace airlight {
 

@@ -1,11 +1,11 @@
 // CPU backend: the shared GLSL per-pixel code compiled as C++ (shader_cpp.hpp),
 // run over the image rows by a pool of threads.
-#include "backends.hpp"
-
 #include <algorithm>
 #include <atomic>
 #include <thread>
 #include <vector>
+
+#include "backends.hpp"
 
 namespace airlight {
 namespace shader {
@@ -35,9 +35,11 @@ struct CpuShader {
 #define HAS_AIRLIGHT (features.airlight)
 #define AIRLIGHT_MARCH (features.airlight_march)
 #define GREY_MEDIUM (features.grey_medium)
+// clang-format off: the same order as the GLSL source (gl_backend.cpp)
 #include "geometry.glsl"
 #include "airlight.glsl"
 #include "shading.glsl"
+// clang-format on
 #undef HAS_MEDIUM
 #undef HAS_POINT_LIGHTS
 #undef HAS_SURFACES

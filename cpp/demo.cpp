@@ -1,14 +1,14 @@
 // airlight-demo: renders a scene file headless to PNG (8-bit sRGB) or PFM
 // (float radiance). Bad input exits non-zero with a one-line message.
-#include "airlight/image_io.hpp"
-#include "airlight/renderer.hpp"
-#include "airlight/scene_io.hpp"
-
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
 #include <string>
+
+#include "airlight/image_io.hpp"
+#include "airlight/renderer.hpp"
+#include "airlight/scene_io.hpp"
 
 #ifdef AIRLIGHT_HAVE_GLFW
 namespace airlight {
@@ -57,18 +57,24 @@ Options parse_args(int argc, char** argv) {
         }
         if (i + 1 >= argc) fail("missing value after " + arg);
         const char* value = argv[++i];
-        if (arg == "--scene") o.scene = value;
-        else if (arg == "--out") o.out = value;
-        else if (arg == "--backend") o.backend = value;
-        else if (arg == "--width") o.width = parse_int(arg, value);
-        else if (arg == "--height") o.height = parse_int(arg, value);
+        if (arg == "--scene")
+            o.scene = value;
+        else if (arg == "--out")
+            o.out = value;
+        else if (arg == "--backend")
+            o.backend = value;
+        else if (arg == "--width")
+            o.width = parse_int(arg, value);
+        else if (arg == "--height")
+            o.height = parse_int(arg, value);
         else if (arg == "--exposure") {
             char* end = nullptr;
             o.exposure = std::strtof(value, &end);
             if (end == value || *end != '\0' || !(o.exposure >= 0.0f) || o.exposure > 1e30f) {
                 fail(std::string("--exposure must be a finite number >= 0, got '") + value + "'");
             }
-        } else fail("unknown option " + arg + " (see --help)");
+        } else
+            fail("unknown option " + arg + " (see --help)");
     }
     if (o.scene.empty()) fail("--scene is required (see --help)");
     if (o.out.empty() && !o.window) fail("--out is required (see --help)");
@@ -104,8 +110,10 @@ int main(int argc, char** argv) {
         backend = Backend::gl;
     } else if (o.backend == "auto") {
         std::string reason;
-        if (gl_backend_available(&reason)) backend = Backend::gl;
-        else std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
+        if (gl_backend_available(&reason))
+            backend = Backend::gl;
+        else
+            std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
     }
     try {
         if (o.window) {
@@ -119,8 +127,10 @@ int main(int argc, char** argv) {
         const auto start = std::chrono::steady_clock::now();
         const Image image = renderer.render(scene);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        if (ends_with(o.out, ".pfm")) write_pfm(o.out, image);
-        else write_png(o.out, image.width, image.height, to_srgb8(image, o.exposure));
+        if (ends_with(o.out, ".pfm"))
+            write_pfm(o.out, image);
+        else
+            write_png(o.out, image.width, image.height, to_srgb8(image, o.exposure));
         std::printf("airlight-demo: %s %dx%d (%s backend, %.1f ms)\n", o.out.c_str(), image.width, image.height,
                     backend_name(backend), ms);
     } catch (const std::exception& e) {

@@ -9,10 +9,9 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
-#include <glm/glm.hpp>
-
 #include <cmath>
 #include <cstdio>
+#include <glm/glm.hpp>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -37,7 +36,8 @@ void main() { color = vec4(texture(image, uv).rgb, 1.0); })";
 
 GLuint build_blit_program() {
     GLuint program = glCreateProgram();
-    for (auto [stage, text] : {std::pair<GLenum, const char*>{GL_VERTEX_SHADER, kVertex}, {GL_FRAGMENT_SHADER, kFragment}}) {
+    for (auto [stage, text] :
+         {std::pair<GLenum, const char*>{GL_VERTEX_SHADER, kVertex}, {GL_FRAGMENT_SHADER, kFragment}}) {
         GLuint s = glCreateShader(stage);
         glShaderSource(s, 1, &text, nullptr);
         glCompileShader(s);

@@ -1,10 +1,9 @@
 #define GLM_ENABLE_EXPERIMENTAL
 #include "frame_data.hpp"
 
-#include <glm/gtx/component_wise.hpp>
-
 #include <algorithm>
 #include <cmath>
+#include <glm/gtx/component_wise.hpp>
 #include <limits>
 
 namespace airlight {
@@ -64,34 +63,34 @@ FrameData make_frame_data(const Scene& scene) {
     for (const Surface& s : scene.surfaces) {
         shader::SurfaceGpu g{};
         switch (s.type) {
-        case SurfaceType::plane:
-            g.p0 = glm::vec4(s.point, 0.0f);
-            g.p1 = glm::vec4(glm::normalize(s.normal), 0.0f);
-            g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_PLANE));
-            break;
-        case SurfaceType::box:
-            g.p0 = glm::vec4(s.box_min, 0.0f);
-            g.p1 = glm::vec4(s.box_max, 0.0f);
-            g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_BOX));
-            break;
-        case SurfaceType::sphere:
-            g.p0 = glm::vec4(s.center, 0.0f);
-            g.p1 = glm::vec4(s.radius, 0.0f, 0.0f, 0.0f);
-            g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_SPHERE));
-            break;
+            case SurfaceType::plane:
+                g.p0 = glm::vec4(s.point, 0.0f);
+                g.p1 = glm::vec4(glm::normalize(s.normal), 0.0f);
+                g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_PLANE));
+                break;
+            case SurfaceType::box:
+                g.p0 = glm::vec4(s.box_min, 0.0f);
+                g.p1 = glm::vec4(s.box_max, 0.0f);
+                g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_BOX));
+                break;
+            case SurfaceType::sphere:
+                g.p0 = glm::vec4(s.center, 0.0f);
+                g.p1 = glm::vec4(s.radius, 0.0f, 0.0f, 0.0f);
+                g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_SPHERE));
+                break;
         }
         data.surfaces.push_back(g);
     }
 
-    f.film_counts = glm::ivec4(scene.film.width, scene.film.height, int(data.point_lights.size()),
-                               int(data.surfaces.size()));
+    f.film_counts =
+        glm::ivec4(scene.film.width, scene.film.height, int(data.point_lights.size()), int(data.surfaces.size()));
     data.features.medium = medium;
     data.features.point_lights = !data.point_lights.empty();
     data.features.surfaces = !data.surfaces.empty();
     data.features.airlight = scattering && !data.point_lights.empty();
     data.features.airlight_march = data.features.airlight && scene.quality.airlight == AirlightMethod::march;
-    data.features.grey_medium = sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z && sigma_s.x == sigma_s.y &&
-                                sigma_s.y == sigma_s.z;
+    data.features.grey_medium =
+        sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z && sigma_s.x == sigma_s.y && sigma_s.y == sigma_s.z;
     if (data.features.airlight) {
         data.surface_glow = &surface_glow_table();
         if (!data.features.airlight_march) data.airlight_tail = &airlight_tail_table();

@@ -1,11 +1,11 @@
 // Scene -> the flat arrays both backends consume (shaders/layout.glsl).
 #pragma once
 
+#include <vector>
+
 #include "airlight/scene.hpp"
 #include "shader_cpp.hpp"
 #include "tables.hpp"
-
-#include <vector>
 
 namespace airlight {
 

@@ -1,11 +1,11 @@
 // GL backend: OpenGL 4.5 core through EGL without a display (surfaceless or
 // device platform), one full-screen fragment shader pass into a float FBO,
 // read back with glReadPixels. See shared HEADLESS-GL notes in docs/.
-#include "backends.hpp"
-#include "shader_sources.hpp"
-
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+
+#include "backends.hpp"
+#include "shader_sources.hpp"
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
@@ -85,9 +85,9 @@ bool create_context(EglContext& out, std::string& reason) {
         EGLConfig config;
         EGLint n_configs = 0;
         const bool have_config = eglChooseConfig(d, config_attribs, &config, 1, &n_configs) && n_configs > 0;
-        const EGLint context_attribs[] = {EGL_CONTEXT_MAJOR_VERSION, 4, EGL_CONTEXT_MINOR_VERSION, 5,
-                                          EGL_CONTEXT_OPENGL_PROFILE_MASK, EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT,
-                                          EGL_NONE};
+        const EGLint context_attribs[] = {
+            EGL_CONTEXT_MAJOR_VERSION,           4,       EGL_CONTEXT_MINOR_VERSION, 5, EGL_CONTEXT_OPENGL_PROFILE_MASK,
+            EGL_CONTEXT_OPENGL_CORE_PROFILE_BIT, EGL_NONE};
         EGLContext ctx = eglCreateContext(d, have_config ? config : EGL_NO_CONFIG_KHR, EGL_NO_CONTEXT, context_attribs);
         if (ctx == EGL_NO_CONTEXT) {
             eglTerminate(d);

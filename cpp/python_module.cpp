@@ -1,18 +1,18 @@
 // airlight._core: the pybind11 bridge. Scenes arrive as Python objects and are
 // converted to JSON values in C++ so that NaN/Inf survive to the validator;
 // scene errors become TypeError/ValueError naming the field.
-#include "airlight/image_io.hpp"
-#include "airlight/renderer.hpp"
-#include "airlight/scene_io.hpp"
-#include "scene_json.hpp"
-#include "tables.hpp"
-
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 
 #include <cstring>
 #include <limits>
 #include <memory>
+
+#include "airlight/image_io.hpp"
+#include "airlight/renderer.hpp"
+#include "airlight/scene_io.hpp"
+#include "scene_json.hpp"
+#include "tables.hpp"
 
 namespace py = pybind11;
 using airlight::Scene;
@@ -112,26 +112,29 @@ PYBIND11_MODULE(_core, m) {
     });
     py::register_exception<airlight::BackendUnavailable>(m, "BackendUnavailableError", PyExc_RuntimeError);
 
-    m.def("validate_scene", [](py::handle scene) { return airlight::scene_to_json(scene_from_python(scene), -1); },
-          "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");
-    m.def("load_scene_file", [](const std::string& path) { return airlight::scene_to_json(airlight::load_scene_file(path), -1); });
+    m.def(
+        "validate_scene", [](py::handle scene) { return airlight::scene_to_json(scene_from_python(scene), -1); },
+        "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");
+    m.def("load_scene_file",
+          [](const std::string& path) { return airlight::scene_to_json(airlight::load_scene_file(path), -1); });
     m.def("gl_backend_available", []() {
         std::string reason;
         const bool ok = airlight::gl_backend_available(&reason);
         return py::make_tuple(ok, reason);
     });
-    m.def("to_srgb8", [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, float exposure) {
-        const airlight::Image image = image_from_numpy(radiance);
-        std::vector<std::uint8_t> bytes;
-        try {
-            bytes = airlight::to_srgb8(image, exposure);
-        } catch (const std::invalid_argument& e) {
-            throw py::value_error(e.what());
-        }
-        py::array_t<std::uint8_t> out({image.height, image.width, 3});
-        std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
-        return out;
-    });
+    m.def("to_srgb8",
+          [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, float exposure) {
+              const airlight::Image image = image_from_numpy(radiance);
+              std::vector<std::uint8_t> bytes;
+              try {
+                  bytes = airlight::to_srgb8(image, exposure);
+              } catch (const std::invalid_argument& e) {
+                  throw py::value_error(e.what());
+              }
+              py::array_t<std::uint8_t> out({image.height, image.width, 3});
+              std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
+              return out;
+          });
 
     m.def("tables_built", []() {
         py::dict out;
@@ -145,10 +148,10 @@ PYBIND11_MODULE(_core, m) {
         }
         return out;
     });
-    m.def("write_pfm", [](const std::string& path,
-                          const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
-        airlight::write_pfm(path, image_from_numpy(radiance));
-    });
+    m.def("write_pfm",
+          [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
+              airlight::write_pfm(path, image_from_numpy(radiance));
+          });
 
     py::class_<airlight::Renderer>(m, "Renderer")
         .def(py::init([](const std::string& backend) {
@@ -157,7 +160,8 @@ PYBIND11_MODULE(_core, m) {
                  throw py::value_error("backend: must be 'gl' or 'cpu', got '" + backend + "'");
              }),
              py::arg("backend"))
-        .def_property_readonly("backend", [](const airlight::Renderer& r) { return airlight::backend_name(r.backend()); })
+        .def_property_readonly("backend",
+                               [](const airlight::Renderer& r) { return airlight::backend_name(r.backend()); })
         .def("set_cpu_threads", &airlight::Renderer::set_cpu_threads)
         .def("render", [](airlight::Renderer& r, py::handle scene_obj) {
             const Scene scene = scene_from_python(scene_obj);

@@ -2,22 +2,21 @@
 // Numbers are validated as doubles; bounds that must survive the conversion to
 // float (strict inequalities, camera and box degeneracy) are checked on the
 // float values, so that parse(write(scene)) reproduces the scene exactly.
-#include "scene_json.hpp"
-
-#include <glm/geometric.hpp>
-#include <glm/vec3.hpp>
-
 #include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <glm/geometric.hpp>
+#include <glm/vec3.hpp>
 #include <limits>
 #include <optional>
 #include <string>
 #include <utility>
 #include <vector>
+
+#include "scene_json.hpp"
 
 namespace airlight {
 namespace {
@@ -39,16 +38,20 @@ using NameTable = std::vector<std::pair<const char*, E>>;
 
 const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic}};
 const NameTable<LightType> light_types{{"point", LightType::point}};
-const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic}, {"march", AirlightMethod::march}};
+const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic},
+                                                 {"march", AirlightMethod::march}};
 const NameTable<SurfaceType> surface_types{
     {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
 
 // Keys allowed in a surface object of each type.
 Names surface_keys(SurfaceType type) {
     switch (type) {
-    case SurfaceType::plane: return {"type", "albedo", "point", "normal"};
-    case SurfaceType::box: return {"type", "albedo", "min", "max"};
-    case SurfaceType::sphere: return {"type", "albedo", "center", "radius"};
+        case SurfaceType::plane:
+            return {"type", "albedo", "point", "normal"};
+        case SurfaceType::box:
+            return {"type", "albedo", "min", "max"};
+        case SurfaceType::sphere:
+            return {"type", "albedo", "center", "radius"};
     }
     return {};
 }
@@ -57,13 +60,9 @@ Names surface_keys(SurfaceType type) {
     throw SceneError(kind, field, message);
 }
 
-std::string join_path(const std::string& path, const std::string& key) {
-    return path.empty() ? key : path + "." + key;
-}
+std::string join_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
-std::string index_path(const std::string& path, std::size_t i) {
-    return path + "[" + std::to_string(i) + "]";
-}
+std::string index_path(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
 std::string join_names(const Names& names) {
     std::string out;
@@ -80,15 +79,22 @@ std::string format_number(double v) {
 // JSON type names in the vocabulary of the Python API.
 std::string type_name(const json& j) {
     switch (j.type()) {
-    case json::value_t::null: return "null";
-    case json::value_t::boolean: return "boolean";
-    case json::value_t::string: return "string";
-    case json::value_t::array: return "list";
-    case json::value_t::object: return "object";
-    case json::value_t::number_integer:
-    case json::value_t::number_unsigned:
-    case json::value_t::number_float: return "number";
-    default: return "unsupported value";
+        case json::value_t::null:
+            return "null";
+        case json::value_t::boolean:
+            return "boolean";
+        case json::value_t::string:
+            return "string";
+        case json::value_t::array:
+            return "list";
+        case json::value_t::object:
+            return "object";
+        case json::value_t::number_integer:
+        case json::value_t::number_unsigned:
+        case json::value_t::number_float:
+            return "number";
+        default:
+            return "unsupported value";
     }
 }
 
@@ -321,29 +327,29 @@ Surface parse_surface(const Obj& o) {
     o.check_keys(surface_keys(s.type));
     if (auto v = o.opt("albedo")) s.albedo = read_rgb(*v, 1.0);
     switch (s.type) {
-    case SurfaceType::plane: {
-        s.point = read_vec3(o.req("point"));
-        Value nv = o.req("normal");
-        glm::dvec3 n(read_vec3(nv));
-        double length = glm::length(n);
-        if (length < 1e-12) fail(Kind::value, nv.field, "normal must be nonzero");
-        // Normals already unit to float precision are kept, so that reloading
-        // a written scene gives the same bits.
-        s.normal = std::abs(length - 1.0) > 1e-6 ? glm::vec3(n / length) : glm::vec3(n);
-        break;
-    }
-    case SurfaceType::box: {
-        s.box_min = read_vec3(o.req("min"));
-        Value max = o.req("max");
-        s.box_max = read_vec3(max);
-        if (!(s.box_min.x < s.box_max.x && s.box_min.y < s.box_max.y && s.box_min.z < s.box_max.z))
-            fail(Kind::value, max.field, "max must be greater than min on every axis");
-        break;
-    }
-    case SurfaceType::sphere:
-        s.center = read_vec3(o.req("center"));
-        s.radius = read_positive(o.req("radius"), infinity, false);
-        break;
+        case SurfaceType::plane: {
+            s.point = read_vec3(o.req("point"));
+            Value nv = o.req("normal");
+            glm::dvec3 n(read_vec3(nv));
+            double length = glm::length(n);
+            if (length < 1e-12) fail(Kind::value, nv.field, "normal must be nonzero");
+            // Normals already unit to float precision are kept, so that reloading
+            // a written scene gives the same bits.
+            s.normal = std::abs(length - 1.0) > 1e-6 ? glm::vec3(n / length) : glm::vec3(n);
+            break;
+        }
+        case SurfaceType::box: {
+            s.box_min = read_vec3(o.req("min"));
+            Value max = o.req("max");
+            s.box_max = read_vec3(max);
+            if (!(s.box_min.x < s.box_max.x && s.box_min.y < s.box_max.y && s.box_min.z < s.box_max.z))
+                fail(Kind::value, max.field, "max must be greater than min on every axis");
+            break;
+        }
+        case SurfaceType::sphere:
+            s.center = read_vec3(o.req("center"));
+            s.radius = read_positive(o.req("radius"), infinity, false);
+            break;
     }
     return s;
 }
@@ -362,9 +368,7 @@ double json_number(float f) {
     return static_cast<double>(f);  // unreachable: 9 digits always round-trip
 }
 
-json json_vec3(const glm::vec3& v) {
-    return json::array({json_number(v.x), json_number(v.y), json_number(v.z)});
-}
+json json_vec3(const glm::vec3& v) { return json::array({json_number(v.x), json_number(v.y), json_number(v.z)}); }
 
 Quality parse_quality(const Obj& o) {
     o.check_keys({"airlight", "march_steps", "cull_fraction"});
@@ -424,18 +428,18 @@ json scene_to_json_value(const Scene& s) {
     for (const auto& sf : s.surfaces) {
         json o = {{"type", name_of(surface_types, sf.type)}, {"albedo", json_vec3(sf.albedo)}};
         switch (sf.type) {
-        case SurfaceType::plane:
-            o["point"] = json_vec3(sf.point);
-            o["normal"] = json_vec3(sf.normal);
-            break;
-        case SurfaceType::box:
-            o["min"] = json_vec3(sf.box_min);
-            o["max"] = json_vec3(sf.box_max);
-            break;
-        case SurfaceType::sphere:
-            o["center"] = json_vec3(sf.center);
-            o["radius"] = json_number(sf.radius);
-            break;
+            case SurfaceType::plane:
+                o["point"] = json_vec3(sf.point);
+                o["normal"] = json_vec3(sf.normal);
+                break;
+            case SurfaceType::box:
+                o["min"] = json_vec3(sf.box_min);
+                o["max"] = json_vec3(sf.box_max);
+                break;
+            case SurfaceType::sphere:
+                o["center"] = json_vec3(sf.center);
+                o["radius"] = json_number(sf.radius);
+                break;
         }
         j["surfaces"].push_back(std::move(o));
     }
@@ -469,8 +473,6 @@ Scene load_scene_file(const std::string& path) {
     return parse_scene(text);
 }
 
-std::string scene_to_json(const Scene& scene, int indent) {
-    return scene_to_json_value(scene).dump(indent);
-}
+std::string scene_to_json(const Scene& scene, int indent) { return scene_to_json_value(scene).dump(indent); }
 
 }  // namespace airlight

@@ -3,9 +3,9 @@
 // values may hold NaN/Inf; they are rejected as "must be finite").
 #pragma once
 
-#include "airlight/scene_io.hpp"
-
 #include <nlohmann/json.hpp>
+
+#include "airlight/scene_io.hpp"
 
 namespace airlight {
 

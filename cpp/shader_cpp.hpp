@@ -23,9 +23,9 @@ struct Features {
     bool medium = false;
     bool point_lights = false;
     bool surfaces = false;
-    bool airlight = false;      // point lights in a scattering medium: airlight and surface glow
+    bool airlight = false;        // point lights in a scattering medium: airlight and surface glow
     bool airlight_march = false;  // brute-force ray marching instead of the tables (benchmarks)
-    bool grey_medium = false;   // sigma_t and sigma_s equal on all channels: one evaluation, not three
+    bool grey_medium = false;     // sigma_t and sigma_s equal on all channels: one evaluation, not three
 
     int key() const {
         return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |

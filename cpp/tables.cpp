@@ -1,13 +1,13 @@
 #include "tables.hpp"
 
-#include "shader_cpp.hpp"
-
-#include <chrono>
 #include <algorithm>
+#include <chrono>
 #include <cmath>
 #include <complex>
 #include <mutex>
 #include <vector>
+
+#include "shader_cpp.hpp"
 
 namespace airlight {
 namespace {
@@ -153,42 +153,41 @@ const Table2D& airlight_tail_table() {
 }
 
 const Table2D& surface_glow_table() {
-    static const Table2D table = timed_build("surface_glow", [] {
-        return build_surface_glow_table(shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY);
-    });
+    static const Table2D table = timed_build(
+        "surface_glow", [] { return build_surface_glow_table(shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY); });
     static const bool registered = register_table(table);
     (void)registered;
     return table;
 }
 
 Table2D build_surface_glow_table(int width, int height) {
-        using namespace shader;
-        Table2D t;
-        t.width = width;
-        t.height = height;
-        t.texels.resize(size_t(t.width) * t.height);
-        const auto nodes = glow_nodes(1);
-        std::vector<double> q(nodes.size());
-        for (int ix = 0; ix < t.width; ++ix) {
-            const double X = double(ix) / (t.width - 1);
-            const double t0 = double(SURFACE_GLOW_T_SCALE);
-            const double T = t0 * std::expm1(X * X * std::log1p(double(SURFACE_GLOW_T_MAX) / t0));
-            // Q depends on T and g only: evaluate once per column, reuse for every theta_s.
-            for (size_t n = 0; n < nodes.size(); ++n) {
-                const double g = nodes[n].first;
-                q[n] = airlight_tail_exact(T * std::sin(g), 0.5 * (kPi - g));
-            }
-            for (int iy = 0; iy < t.height; ++iy) {
-                const double c = surface_glow_cos_theta(double(iy) / (t.height - 1), T);
-                const double theta_s = std::acos(c);
-                double sum = 0.0;
-                for (size_t n = 0; n < nodes.size(); ++n) {
-                    sum += nodes[n].second * q[n] * clamped_cosine_ring(nodes[n].first, theta_s);
-                }
-                t.texels[size_t(iy) * t.width + ix] = float(std::log(sum));
-            }
+    using namespace shader;
+    Table2D t;
+    t.width = width;
+    t.height = height;
+    t.texels.resize(size_t(t.width) * t.height);
+    const auto nodes = glow_nodes(1);
+    std::vector<double> q(nodes.size());
+    for (int ix = 0; ix < t.width; ++ix) {
+        const double X = double(ix) / (t.width - 1);
+        const double t0 = double(SURFACE_GLOW_T_SCALE);
+        const double T = t0 * std::expm1(X * X * std::log1p(double(SURFACE_GLOW_T_MAX) / t0));
+        // Q depends on T and g only: evaluate once per column, reuse for every theta_s.
+        for (size_t n = 0; n < nodes.size(); ++n) {
+            const double g = nodes[n].first;
+            q[n] = airlight_tail_exact(T * std::sin(g), 0.5 * (kPi - g));
         }
-        return t;
+        for (int iy = 0; iy < t.height; ++iy) {
+            const double c = surface_glow_cos_theta(double(iy) / (t.height - 1), T);
+            const double theta_s = std::acos(c);
+            double sum = 0.0;
+            for (size_t n = 0; n < nodes.size(); ++n) {
+                sum += nodes[n].second * q[n] * clamped_cosine_ring(nodes[n].first, theta_s);
+            }
+            t.texels[size_t(iy) * t.width + ix] = float(std::log(sum));
+        }
+    }
+    return t;
 }
 
 std::vector<TableInfo> tables_built() {

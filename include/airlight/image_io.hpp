@@ -1,11 +1,11 @@
 // Turning linear radiance into display values and writing image files.
 #pragma once
 
-#include "airlight/renderer.hpp"
-
 #include <cstdint>
 #include <string>
 #include <vector>
+
+#include "airlight/renderer.hpp"
 
 namespace airlight {
 

@@ -1,12 +1,12 @@
 // Rendering a scene to linear radiance with the GL or the CPU backend.
 #pragma once
 
-#include "airlight/scene.hpp"
-
 #include <memory>
 #include <stdexcept>
 #include <string>
 #include <vector>
+
+#include "airlight/scene.hpp"
 
 namespace airlight {
 

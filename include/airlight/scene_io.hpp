@@ -1,10 +1,10 @@
 // Loading, validating and writing scenes in the JSON format of the README.
 #pragma once
 
-#include "airlight/scene.hpp"
-
 #include <stdexcept>
 #include <string>
+
+#include "airlight/scene.hpp"
 
 namespace airlight {
 
@@ -15,8 +15,7 @@ class SceneError : public std::runtime_error {
 public:
     enum class Kind { type, value };
     SceneError(Kind kind, std::string field, const std::string& message)
-        : std::runtime_error(field.empty() ? message : field + ": " + message),
-          kind_(kind), field_(std::move(field)) {}
+        : std::runtime_error(field.empty() ? message : field + ": " + message), kind_(kind), field_(std::move(field)) {}
     Kind kind() const { return kind_; }
     const std::string& field() const { return field_; }
 

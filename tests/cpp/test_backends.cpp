@@ -1,13 +1,13 @@
 // The two backends run the same shared shader code: every shader variant
 // compiles in GL, GL and CPU agree within 0.5% away from geometric edges, and
 // the image conventions (row 0 on top, lamp core radiance) hold on both.
-#include "airlight/renderer.hpp"
-#include "airlight/scene_io.hpp"
-#include "check.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <string>
+
+#include "airlight/renderer.hpp"
+#include "airlight/scene_io.hpp"
+#include "check.hpp"
 
 using namespace airlight;
 
@@ -64,7 +64,8 @@ void test_cpu_conventions() {
     // The lamp at the view centre shows its core: I / (pi r^2) attenuated over 8 - 0.3 m.
     const float expected = 2.0f / (3.14159265f * 0.09f) * std::exp(-0.02f * 7.7f);
     const float centre = img.rgb[(size_t(32) * 96 + 48) * 3 + 0];
-    CHECK_MSG(std::abs(centre - expected) < 1e-3f * expected, std::to_string(centre) + " vs " + std::to_string(expected));
+    CHECK_MSG(std::abs(centre - expected) < 1e-3f * expected,
+              std::to_string(centre) + " vs " + std::to_string(expected));
     // Row 0 is the top: looking level at a plane below, the ground is in the bottom rows only.
     scene.point_lights.resize(1);
     scene.surfaces.resize(1);

@@ -1,18 +1,17 @@
 // Tests of the scene loader (cpp/scene_io.cpp): every validation rule of the
 // README "Scene format", the README example, and exact round trips.
 // Self-contained: prints each failure, exits non-zero if any.
-#include "airlight/scene_io.hpp"
-#include "scene_json.hpp"
-
-#include <glm/geometric.hpp>
-
 #include <cmath>
 #include <cstdio>
 #include <functional>
+#include <glm/geometric.hpp>
 #include <limits>
 #include <random>
 #include <string>
 #include <vector>
+
+#include "airlight/scene_io.hpp"
+#include "scene_json.hpp"
 
 using airlight::SceneError;
 using json = nlohmann::json;
@@ -92,8 +91,8 @@ const std::vector<BadCase> bad_cases = {
     // Top level.
     {"scene not an object", [](json& j) { j = json::array({1}); }, Kind::type, "", "scene must be a JSON object"},
     {"scene null", [](json& j) { j = nullptr; }, Kind::type, "", "scene must be a JSON object"},
-    {"typo key", [](json& j) { j["camra"] = j["camera"]; },
-     Kind::value, "camra", "unknown key; did you mean 'camera'?"},
+    {"typo key", [](json& j) { j["camra"] = j["camera"]; }, Kind::value, "camra",
+     "unknown key; did you mean 'camera'?"},
     {"unknown key", [](json& j) { j["zzzzzzz"] = 1; }, Kind::value, "zzzzzzz", "unknown key"},
     {"typo lights", [](json& j) { j["light"] = json::array(); }, Kind::value, "light", "did you mean 'lights'?"},
     {"missing film", [](json& j) { j.erase("film"); }, Kind::value, "film", "missing required key"},
@@ -104,14 +103,14 @@ const std::vector<BadCase> bad_cases = {
     {"width 0", [](json& j) { j["film"]["width"] = 0; }, Kind::value, "film.width", "must be in [1, 16384]"},
     {"width negative", [](json& j) { j["film"]["width"] = -5; }, Kind::value, "film.width", "must be in"},
     {"width huge", [](json& j) { j["film"]["width"] = 16385; }, Kind::value, "film.width", "must be in"},
-    {"height uint64", [](json& j) { j["film"]["height"] = 18446744073709551615ull; },
-     Kind::value, "film.height", "must be in"},
+    {"height uint64", [](json& j) { j["film"]["height"] = 18446744073709551615ull; }, Kind::value, "film.height",
+     "must be in"},
     {"width float", [](json& j) { j["film"]["width"] = 320.5; }, Kind::value, "film.width", "must be an integer"},
     {"width 1e300", [](json& j) { j["film"]["width"] = 1e300; }, Kind::value, "film.width", "must be in"},
-    {"width string", [](json& j) { j["film"]["width"] = "320"; },
-     Kind::type, "film.width", "expected a number, got string"},
-    {"width bool", [](json& j) { j["film"]["width"] = true; },
-     Kind::type, "film.width", "expected a number, got boolean"},
+    {"width string", [](json& j) { j["film"]["width"] = "320"; }, Kind::type, "film.width",
+     "expected a number, got string"},
+    {"width bool", [](json& j) { j["film"]["width"] = true; }, Kind::type, "film.width",
+     "expected a number, got boolean"},
     {"width NaN", [](json& j) { j["film"]["width"] = nan; }, Kind::value, "film.width", "must be finite"},
     {"height missing", [](json& j) { j["film"].erase("height"); }, Kind::value, "film.height", "missing required key"},
     {"film extra", [](json& j) { j["film"]["depth"] = 3; }, Kind::value, "film.depth", "unknown key"},
@@ -120,176 +119,248 @@ const std::vector<BadCase> bad_cases = {
     {"fov 0", [](json& j) { j["camera"]["fov_y"] = 0; }, Kind::value, "camera.fov_y", "must be > 0"},
     {"fov negative", [](json& j) { j["camera"]["fov_y"] = -10; }, Kind::value, "camera.fov_y", "must be > 0"},
     {"fov 180", [](json& j) { j["camera"]["fov_y"] = 180; }, Kind::value, "camera.fov_y", "must be < 180"},
-    {"fov 180 as float", [](json& j) { j["camera"]["fov_y"] = 179.999999999; },
-     Kind::value, "camera.fov_y", "must be < 180"},
+    {"fov 180 as float", [](json& j) { j["camera"]["fov_y"] = 179.999999999; }, Kind::value, "camera.fov_y",
+     "must be < 180"},
     {"fov NaN", [](json& j) { j["camera"]["fov_y"] = nan; }, Kind::value, "camera.fov_y", "must be finite"},
     {"fov inf", [](json& j) { j["camera"]["fov_y"] = inf; }, Kind::value, "camera.fov_y", "must be finite"},
-    {"fov string", [](json& j) { j["camera"]["fov_y"] = "60"; },
-     Kind::type, "camera.fov_y", "expected a number, got string"},
+    {"fov string", [](json& j) { j["camera"]["fov_y"] = "60"; }, Kind::type, "camera.fov_y",
+     "expected a number, got string"},
     {"fov bool", [](json& j) { j["camera"]["fov_y"] = false; }, Kind::type, "camera.fov_y", "expected a number"},
     {"fov missing", [](json& j) { j["camera"].erase("fov_y"); }, Kind::value, "camera.fov_y", "missing required key"},
     {"fov typo", [](json& j) { j["camera"]["fovy"] = 60; }, Kind::value, "camera.fovy", "did you mean 'fov_y'?"},
-    {"look_at missing", [](json& j) { j["camera"].erase("look_at"); },
-     Kind::value, "camera.look_at", "missing required key"},
-    {"position short", [](json& j) { j["camera"]["position"] = {0, 1}; }, Kind::value, "camera.position", "exactly 3"},
-    {"position long", [](json& j) { j["camera"]["position"] = {0, 1, 2, 3}; },
+    {"look_at missing", [](json& j) { j["camera"].erase("look_at"); }, Kind::value, "camera.look_at",
+     "missing required key"},
+    {"position short",
+     [](json& j) {
+         j["camera"]["position"] = {0, 1};
+     },
      Kind::value, "camera.position", "exactly 3"},
-    {"position string", [](json& j) { j["camera"]["position"] = "origin"; },
-     Kind::type, "camera.position", "expected a list"},
+    {"position long",
+     [](json& j) {
+         j["camera"]["position"] = {0, 1, 2, 3};
+     },
+     Kind::value, "camera.position", "exactly 3"},
+    {"position string", [](json& j) { j["camera"]["position"] = "origin"; }, Kind::type, "camera.position",
+     "expected a list"},
     {"position scalar", [](json& j) { j["camera"]["position"] = 0; }, Kind::type, "camera.position", "expected a list"},
     {"position null", [](json& j) { j["camera"]["position"] = nullptr; }, Kind::type, "camera.position", "got null"},
-    {"position bool elem", [](json& j) { j["camera"]["position"] = {0, true, 0}; },
+    {"position bool elem",
+     [](json& j) {
+         j["camera"]["position"] = {0, true, 0};
+     },
      Kind::type, "camera.position", "expected a number, got boolean"},
-    {"position string elem", [](json& j) { j["camera"]["position"] = {0, "1", 0}; },
+    {"position string elem",
+     [](json& j) {
+         j["camera"]["position"] = {0, "1", 0};
+     },
      Kind::type, "camera.position", "expected a number, got string"},
-    {"position NaN", [](json& j) { j["camera"]["position"] = {0, nan, 0}; },
+    {"position NaN",
+     [](json& j) {
+         j["camera"]["position"] = {0, nan, 0};
+     },
      Kind::value, "camera.position", "must be finite"},
-    {"position -inf", [](json& j) { j["camera"]["position"] = {-inf, 0, 0}; },
+    {"position -inf",
+     [](json& j) {
+         j["camera"]["position"] = {-inf, 0, 0};
+     },
      Kind::value, "camera.position", "must be finite"},
-    {"position absurd", [](json& j) { j["camera"]["position"] = {0, 2e7, 0}; },
+    {"position absurd",
+     [](json& j) {
+         j["camera"]["position"] = {0, 2e7, 0};
+     },
      Kind::value, "camera.position", "absurd coordinate"},
-    {"look_at absurd", [](json& j) { j["camera"]["look_at"] = {0, 0, -1.5e7}; },
+    {"look_at absurd",
+     [](json& j) {
+         j["camera"]["look_at"] = {0, 0, -1.5e7};
+     },
      Kind::value, "camera.look_at", "absurd coordinate"},
-    {"up NaN", [](json& j) { j["camera"]["up"] = {0, nan, 0}; }, Kind::value, "camera.up", "must be finite"},
-    {"look_at = position", [](json& j) { j["camera"]["look_at"] = {0, 1.7, 0}; },
+    {"up NaN",
+     [](json& j) {
+         j["camera"]["up"] = {0, nan, 0};
+     },
+     Kind::value, "camera.up", "must be finite"},
+    {"look_at = position",
+     [](json& j) {
+         j["camera"]["look_at"] = {0, 1.7, 0};
+     },
      Kind::value, "camera.look_at", "look_at equals position"},
-    {"look_at ~ position", [](json& j) { j["camera"]["look_at"] = {0, 1.7, 1e-8}; },
+    {"look_at ~ position",
+     [](json& j) {
+         j["camera"]["look_at"] = {0, 1.7, 1e-8};
+     },
      Kind::value, "camera.look_at", "look_at equals position"},
-    {"up zero", [](json& j) { j["camera"]["up"] = {0, 0, 0}; }, Kind::value, "camera.up", "parallel"},
-    {"up parallel", [](json& j) { j["camera"]["up"] = {0, 0, -1}; }, Kind::value, "camera.up", "parallel"},
-    {"up antiparallel", [](json& j) { j["camera"]["up"] = {0, 0, 5}; }, Kind::value, "camera.up", "parallel"},
+    {"up zero",
+     [](json& j) {
+         j["camera"]["up"] = {0, 0, 0};
+     },
+     Kind::value, "camera.up", "parallel"},
+    {"up parallel",
+     [](json& j) {
+         j["camera"]["up"] = {0, 0, -1};
+     },
+     Kind::value, "camera.up", "parallel"},
+    {"up antiparallel",
+     [](json& j) {
+         j["camera"]["up"] = {0, 0, 5};
+     },
+     Kind::value, "camera.up", "parallel"},
     // Medium.
     {"medium scalar", [](json& j) { j["medium"] = 5; }, Kind::type, "medium", "expected an object"},
     {"medium list", [](json& j) { j["medium"] = json::array(); }, Kind::type, "medium", "expected an object"},
-    {"sigma_t missing", [](json& j) { j["medium"].erase("sigma_t"); },
-     Kind::value, "medium.sigma_t", "missing required key"},
+    {"sigma_t missing", [](json& j) { j["medium"].erase("sigma_t"); }, Kind::value, "medium.sigma_t",
+     "missing required key"},
     {"sigma_t negative", [](json& j) { j["medium"]["sigma_t"] = -1; }, Kind::value, "medium.sigma_t", "must be >= 0"},
-    {"sigma_t negative elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, -0.1, 0}; },
+    {"sigma_t negative elem",
+     [](json& j) {
+         j["medium"]["sigma_t"] = {0.1, -0.1, 0};
+     },
      Kind::value, "medium.sigma_t", "must be >= 0"},
-    {"sigma_t short", [](json& j) { j["medium"]["sigma_t"] = {0.1, 0.2}; }, Kind::value, "medium.sigma_t", "exactly 3"},
+    {"sigma_t short",
+     [](json& j) {
+         j["medium"]["sigma_t"] = {0.1, 0.2};
+     },
+     Kind::value, "medium.sigma_t", "exactly 3"},
     {"sigma_t string", [](json& j) { j["medium"]["sigma_t"] = "thick"; }, Kind::type, "medium.sigma_t", "got string"},
     {"sigma_t bool", [](json& j) { j["medium"]["sigma_t"] = true; }, Kind::type, "medium.sigma_t", "got boolean"},
-    {"sigma_t bool elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, false, 0.1}; },
+    {"sigma_t bool elem",
+     [](json& j) {
+         j["medium"]["sigma_t"] = {0.1, false, 0.1};
+     },
      Kind::type, "medium.sigma_t", "expected a number, got boolean"},
     {"sigma_t NaN", [](json& j) { j["medium"]["sigma_t"] = nan; }, Kind::value, "medium.sigma_t", "must be finite"},
-    {"sigma_t inf elem", [](json& j) { j["medium"]["sigma_t"] = {0.1, inf, 0.1}; },
+    {"sigma_t inf elem",
+     [](json& j) {
+         j["medium"]["sigma_t"] = {0.1, inf, 0.1};
+     },
      Kind::value, "medium.sigma_t", "must be finite"},
-    {"sigma_t beyond float", [](json& j) { j["medium"]["sigma_t"] = 1e39; },
-     Kind::value, "medium.sigma_t", "32-bit float"},
+    {"sigma_t beyond float", [](json& j) { j["medium"]["sigma_t"] = 1e39; }, Kind::value, "medium.sigma_t",
+     "32-bit float"},
     {"medium albedo > 1", [](json& j) { j["medium"]["albedo"] = 1.5; }, Kind::value, "medium.albedo", "must be <= 1"},
-    {"medium albedo elem > 1", [](json& j) { j["medium"]["albedo"] = {0.5, 0.5, 1.01}; },
+    {"medium albedo elem > 1",
+     [](json& j) {
+         j["medium"]["albedo"] = {0.5, 0.5, 1.01};
+     },
      Kind::value, "medium.albedo", "must be <= 1"},
     {"medium albedo < 0", [](json& j) { j["medium"]["albedo"] = -0.1; }, Kind::value, "medium.albedo", "must be >= 0"},
     {"medium typo", [](json& j) { j["medium"]["sigma"] = 1; }, Kind::value, "medium.sigma", "did you mean 'sigma_t'?"},
-    {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "hg"; },
-     Kind::value, "medium.phase.type", "isotropic"},
-    {"phase type missing", [](json& j) { j["medium"]["phase"] = json::object(); },
-     Kind::value, "medium.phase.type", "missing required key"},
-    {"phase type number", [](json& j) { j["medium"]["phase"]["type"] = 3; },
-     Kind::type, "medium.phase.type", "expected a string"},
-    {"phase not object", [](json& j) { j["medium"]["phase"] = "isotropic"; },
-     Kind::type, "medium.phase", "expected an object"},
+    {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "hg"; }, Kind::value, "medium.phase.type",
+     "isotropic"},
+    {"phase type missing", [](json& j) { j["medium"]["phase"] = json::object(); }, Kind::value, "medium.phase.type",
+     "missing required key"},
+    {"phase type number", [](json& j) { j["medium"]["phase"]["type"] = 3; }, Kind::type, "medium.phase.type",
+     "expected a string"},
+    {"phase not object", [](json& j) { j["medium"]["phase"] = "isotropic"; }, Kind::type, "medium.phase",
+     "expected an object"},
     {"phase extra key", [](json& j) { j["medium"]["phase"]["g"] = 0.5; }, Kind::value, "medium.phase.g", "unknown key"},
     // Lights.
     {"lights object", [](json& j) { j["lights"] = json::object(); }, Kind::type, "lights", "expected a list"},
     {"lights null", [](json& j) { j["lights"] = nullptr; }, Kind::type, "lights", "expected a list"},
     {"light not object", [](json& j) { j["lights"][0] = 5; }, Kind::type, "lights[0]", "expected an object"},
-    {"light type missing", [](json& j) { j["lights"][0].erase("type"); },
-     Kind::value, "lights[0].type", "missing required key"},
+    {"light type missing", [](json& j) { j["lights"][0].erase("type"); }, Kind::value, "lights[0].type",
+     "missing required key"},
     {"light type unknown", [](json& j) { j["lights"][0]["type"] = "spot"; }, Kind::value, "lights[0].type", "point"},
-    {"light type number", [](json& j) { j["lights"][0]["type"] = 1; },
-     Kind::type, "lights[0].type", "expected a string"},
-    {"light position missing", [](json& j) { j["lights"][0].erase("position"); },
-     Kind::value, "lights[0].position", "missing required key"},
-    {"light position absurd", [](json& j) { j["lights"][0]["position"] = {1e8, 0, 0}; },
+    {"light type number", [](json& j) { j["lights"][0]["type"] = 1; }, Kind::type, "lights[0].type",
+     "expected a string"},
+    {"light position missing", [](json& j) { j["lights"][0].erase("position"); }, Kind::value, "lights[0].position",
+     "missing required key"},
+    {"light position absurd",
+     [](json& j) {
+         j["lights"][0]["position"] = {1e8, 0, 0};
+     },
      Kind::value, "lights[0].position", "absurd coordinate"},
-    {"light intensity missing", [](json& j) { j["lights"][1].erase("intensity"); },
-     Kind::value, "lights[1].intensity", "missing required key"},
-    {"light intensity negative", [](json& j) { j["lights"][0]["intensity"] = -1; },
-     Kind::value, "lights[0].intensity", "must be >= 0"},
-    {"light intensity long", [](json& j) { j["lights"][0]["intensity"] = {1, 2, 3, 4}; },
+    {"light intensity missing", [](json& j) { j["lights"][1].erase("intensity"); }, Kind::value, "lights[1].intensity",
+     "missing required key"},
+    {"light intensity negative", [](json& j) { j["lights"][0]["intensity"] = -1; }, Kind::value, "lights[0].intensity",
+     "must be >= 0"},
+    {"light intensity long",
+     [](json& j) {
+         j["lights"][0]["intensity"] = {1, 2, 3, 4};
+     },
      Kind::value, "lights[0].intensity", "exactly 3"},
-    {"light intensity NaN", [](json& j) { j["lights"][0]["intensity"] = {1, 2, nan}; },
+    {"light intensity NaN",
+     [](json& j) {
+         j["lights"][0]["intensity"] = {1, 2, nan};
+     },
      Kind::value, "lights[0].intensity", "must be finite"},
     {"light radius 0", [](json& j) { j["lights"][0]["radius"] = 0; }, Kind::value, "lights[0].radius", "must be > 0"},
-    {"light radius negative", [](json& j) { j["lights"][0]["radius"] = -1; },
-     Kind::value, "lights[0].radius", "must be > 0"},
-    {"light radius tiny", [](json& j) { j["lights"][0]["radius"] = 1e-60; },
-     Kind::value, "lights[0].radius", "must be > 0"},
-    {"light radius huge", [](json& j) { j["lights"][0]["radius"] = 1000.5; },
-     Kind::value, "lights[0].radius", "must be <= 1000"},
-    {"light radius NaN", [](json& j) { j["lights"][1]["radius"] = nan; },
-     Kind::value, "lights[1].radius", "must be finite"},
-    {"light radius string", [](json& j) { j["lights"][0]["radius"] = "big"; },
-     Kind::type, "lights[0].radius", "expected a number"},
+    {"light radius negative", [](json& j) { j["lights"][0]["radius"] = -1; }, Kind::value, "lights[0].radius",
+     "must be > 0"},
+    {"light radius tiny", [](json& j) { j["lights"][0]["radius"] = 1e-60; }, Kind::value, "lights[0].radius",
+     "must be > 0"},
+    {"light radius huge", [](json& j) { j["lights"][0]["radius"] = 1000.5; }, Kind::value, "lights[0].radius",
+     "must be <= 1000"},
+    {"light radius NaN", [](json& j) { j["lights"][1]["radius"] = nan; }, Kind::value, "lights[1].radius",
+     "must be finite"},
+    {"light radius string", [](json& j) { j["lights"][0]["radius"] = "big"; }, Kind::type, "lights[0].radius",
+     "expected a number"},
     {"light extra key", [](json& j) { j["lights"][0]["colour"] = 1; }, Kind::value, "lights[0].colour", "unknown key"},
-    {"light typo", [](json& j) { j["lights"][0]["intensty"] = 1; },
-     Kind::value, "lights[0].intensty", "did you mean 'intensity'?"},
+    {"light typo", [](json& j) { j["lights"][0]["intensty"] = 1; }, Kind::value, "lights[0].intensty",
+     "did you mean 'intensity'?"},
     {"third light",
      [](json& j) { j["lights"].push_back({{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", {1, -2, 3}}}); },
      Kind::value, "lights[2].intensity", "must be >= 0"},
     // Surfaces.
     {"surfaces string", [](json& j) { j["surfaces"] = "x"; }, Kind::type, "surfaces", "expected a list"},
-    {"surface not object", [](json& j) { j["surfaces"][1] = json::array(); },
-     Kind::type, "surfaces[1]", "expected an object"},
-    {"surface type missing", [](json& j) { j["surfaces"][0].erase("type"); },
-     Kind::value, "surfaces[0].type", "missing required key"},
-    {"surface type unknown", [](json& j) { j["surfaces"][0]["type"] = "disk"; },
-     Kind::value, "surfaces[0].type", "plane, box, sphere"},
-    {"surface type bool", [](json& j) { j["surfaces"][0]["type"] = true; },
-     Kind::type, "surfaces[0].type", "expected a string"},
-    {"surface albedo > 1", [](json& j) { j["surfaces"][0]["albedo"] = 2; },
-     Kind::value, "surfaces[0].albedo", "must be <= 1"},
-    {"surface albedo NaN", [](json& j) { j["surfaces"][1]["albedo"] = nan; },
-     Kind::value, "surfaces[1].albedo", "must be finite"},
-    {"surface albedo string", [](json& j) { j["surfaces"][1]["albedo"] = "grey"; },
-     Kind::type, "surfaces[1].albedo", "got string"},
-    {"plane normal missing", [](json& j) { j["surfaces"][0].erase("normal"); },
-     Kind::value, "surfaces[0].normal", "missing required key"},
-    {"plane point missing", [](json& j) { j["surfaces"][0].erase("point"); },
-     Kind::value, "surfaces[0].point", "missing required key"},
-    {"plane normal zero", [](json& j) { j["surfaces"][0]["normal"] = {0, 0, 0}; },
-     Kind::value, "surfaces[0].normal", "nonzero"},
-    {"plane normal tiny", [](json& j) { j["surfaces"][0]["normal"] = {1e-14, 0, 0}; },
-     Kind::value, "surfaces[0].normal", "nonzero"},
-    {"plane normal short", [](json& j) { j["surfaces"][0]["normal"] = {0, 1}; },
-     Kind::value, "surfaces[0].normal", "exactly 3"},
-    {"plane point absurd", [](json& j) { j["surfaces"][0]["point"] = {0, -1e9, 0}; },
-     Kind::value, "surfaces[0].point", "absurd coordinate"},
-    {"plane with radius", [](json& j) { j["surfaces"][0]["radius"] = 1; },
-     Kind::value, "surfaces[0].radius", "unknown key"},
-    {"plane with min", [](json& j) { j["surfaces"][0]["min"] = {0, 0, 0}; },
-     Kind::value, "surfaces[0].min", "unknown key"},
-    {"box min missing", [](json& j) { j["surfaces"][1].erase("min"); },
-     Kind::value, "surfaces[1].min", "missing required key"},
-    {"box max missing", [](json& j) { j["surfaces"][1].erase("max"); },
-     Kind::value, "surfaces[1].max", "missing required key"},
-    {"box inverted", [](json& j) { j["surfaces"][1]["max"] = {-9, 12, -25}; },
-     Kind::value, "surfaces[1].max", "greater than min"},
-    {"box flat", [](json& j) { j["surfaces"][1]["max"] = {-4, 12, -40}; },
-     Kind::value, "surfaces[1].max", "greater than min"},
-    {"box with normal", [](json& j) { j["surfaces"][1]["normal"] = {0, 1, 0}; },
-     Kind::value, "surfaces[1].normal", "unknown key"},
-    {"box min NaN", [](json& j) { j["surfaces"][1]["min"] = {nan, 0, 0}; },
-     Kind::value, "surfaces[1].min", "must be finite"},
-    {"sphere radius 0", [](json& j) { j["surfaces"][2]["radius"] = 0; },
-     Kind::value, "surfaces[2].radius", "must be > 0"},
-    {"sphere radius negative", [](json& j) { j["surfaces"][2]["radius"] = -1; },
-     Kind::value, "surfaces[2].radius", "must be > 0"},
-    {"sphere radius inf", [](json& j) { j["surfaces"][2]["radius"] = inf; },
-     Kind::value, "surfaces[2].radius", "must be finite"},
-    {"sphere radius beyond float", [](json& j) { j["surfaces"][2]["radius"] = 1e300; },
-     Kind::value, "surfaces[2].radius", "32-bit float"},
-    {"sphere radius missing", [](json& j) { j["surfaces"][2].erase("radius"); },
-     Kind::value, "surfaces[2].radius", "missing required key"},
-    {"sphere center missing", [](json& j) { j["surfaces"][2].erase("center"); },
-     Kind::value, "surfaces[2].center", "missing required key"},
-    {"sphere center bool", [](json& j) { j["surfaces"][2]["center"] = true; },
-     Kind::type, "surfaces[2].center", "expected a list"},
-    {"sphere typo", [](json& j) { j["surfaces"][2]["centre"] = {0, 0, 0}; },
-     Kind::value, "surfaces[2].centre", "did you mean 'center'?"},
-    {"sphere with point", [](json& j) { j["surfaces"][2]["point"] = {0, 0, 0}; },
-     Kind::value, "surfaces[2].point", "unknown key"},
+    {"surface not object", [](json& j) { j["surfaces"][1] = json::array(); }, Kind::type, "surfaces[1]",
+     "expected an object"},
+    {"surface type missing", [](json& j) { j["surfaces"][0].erase("type"); }, Kind::value, "surfaces[0].type",
+     "missing required key"},
+    {"surface type unknown", [](json& j) { j["surfaces"][0]["type"] = "disk"; }, Kind::value, "surfaces[0].type",
+     "plane, box, sphere"},
+    {"surface type bool", [](json& j) { j["surfaces"][0]["type"] = true; }, Kind::type, "surfaces[0].type",
+     "expected a string"},
+    {"surface albedo > 1", [](json& j) { j["surfaces"][0]["albedo"] = 2; }, Kind::value, "surfaces[0].albedo",
+     "must be <= 1"},
+    {"surface albedo NaN", [](json& j) { j["surfaces"][1]["albedo"] = nan; }, Kind::value, "surfaces[1].albedo",
+     "must be finite"},
+    {"surface albedo string", [](json& j) { j["surfaces"][1]["albedo"] = "grey"; }, Kind::type, "surfaces[1].albedo",
+     "got string"},
+    {"plane normal missing", [](json& j) { j["surfaces"][0].erase("normal"); }, Kind::value, "surfaces[0].normal",
+     "missing required key"},
+    {"plane point missing", [](json& j) { j["surfaces"][0].erase("point"); }, Kind::value, "surfaces[0].point",
+     "missing required key"},
+    {"plane normal zero", [](json& j) { j["surfaces"][0]["normal"] = {0, 0, 0}; }, Kind::value, "surfaces[0].normal",
+     "nonzero"},
+    {"plane normal tiny", [](json& j) { j["surfaces"][0]["normal"] = {1e-14, 0, 0}; }, Kind::value,
+     "surfaces[0].normal", "nonzero"},
+    {"plane normal short", [](json& j) { j["surfaces"][0]["normal"] = {0, 1}; }, Kind::value, "surfaces[0].normal",
+     "exactly 3"},
+    {"plane point absurd", [](json& j) { j["surfaces"][0]["point"] = {0, -1e9, 0}; }, Kind::value, "surfaces[0].point",
+     "absurd coordinate"},
+    {"plane with radius", [](json& j) { j["surfaces"][0]["radius"] = 1; }, Kind::value, "surfaces[0].radius",
+     "unknown key"},
+    {"plane with min", [](json& j) { j["surfaces"][0]["min"] = {0, 0, 0}; }, Kind::value, "surfaces[0].min",
+     "unknown key"},
+    {"box min missing", [](json& j) { j["surfaces"][1].erase("min"); }, Kind::value, "surfaces[1].min",
+     "missing required key"},
+    {"box max missing", [](json& j) { j["surfaces"][1].erase("max"); }, Kind::value, "surfaces[1].max",
+     "missing required key"},
+    {"box inverted", [](json& j) { j["surfaces"][1]["max"] = {-9, 12, -25}; }, Kind::value, "surfaces[1].max",
+     "greater than min"},
+    {"box flat", [](json& j) { j["surfaces"][1]["max"] = {-4, 12, -40}; }, Kind::value, "surfaces[1].max",
+     "greater than min"},
+    {"box with normal", [](json& j) { j["surfaces"][1]["normal"] = {0, 1, 0}; }, Kind::value, "surfaces[1].normal",
+     "unknown key"},
+    {"box min NaN", [](json& j) { j["surfaces"][1]["min"] = {nan, 0, 0}; }, Kind::value, "surfaces[1].min",
+     "must be finite"},
+    {"sphere radius 0", [](json& j) { j["surfaces"][2]["radius"] = 0; }, Kind::value, "surfaces[2].radius",
+     "must be > 0"},
+    {"sphere radius negative", [](json& j) { j["surfaces"][2]["radius"] = -1; }, Kind::value, "surfaces[2].radius",
+     "must be > 0"},
+    {"sphere radius inf", [](json& j) { j["surfaces"][2]["radius"] = inf; }, Kind::value, "surfaces[2].radius",
+     "must be finite"},
+    {"sphere radius beyond float", [](json& j) { j["surfaces"][2]["radius"] = 1e300; }, Kind::value,
+     "surfaces[2].radius", "32-bit float"},
+    {"sphere radius missing", [](json& j) { j["surfaces"][2].erase("radius"); }, Kind::value, "surfaces[2].radius",
+     "missing required key"},
+    {"sphere center missing", [](json& j) { j["surfaces"][2].erase("center"); }, Kind::value, "surfaces[2].center",
+     "missing required key"},
+    {"sphere center bool", [](json& j) { j["surfaces"][2]["center"] = true; }, Kind::type, "surfaces[2].center",
+     "expected a list"},
+    {"sphere typo", [](json& j) { j["surfaces"][2]["centre"] = {0, 0, 0}; }, Kind::value, "surfaces[2].centre",
+     "did you mean 'center'?"},
+    {"sphere with point", [](json& j) { j["surfaces"][2]["point"] = {0, 0, 0}; }, Kind::value, "surfaces[2].point",
+     "unknown key"},
     // Background.
     {"background negative", [](json& j) { j["background"] = -1; }, Kind::value, "background", "must be >= 0"},
     {"background string", [](json& j) { j["background"] = "black"; }, Kind::type, "background", "got string"},
@@ -369,13 +440,13 @@ void test_defaults_and_accepted_forms() {
     j.erase("medium");
     j.erase("background");
     j["surfaces"][0].erase("albedo");
-    j["film"]["width"] = 320.0;                       // integral float
-    j["film"]["height"] = 16384u;                     // unsigned, upper bound
-    j["lights"][0]["radius"] = 1000;                  // upper bound inclusive
-    j["surfaces"][0]["normal"] = {0, 2, 0};           // normalised on load
-    j["surfaces"][1]["albedo"] = {0, 1, 0.25};        // albedo bounds inclusive
+    j["film"]["width"] = 320.0;                 // integral float
+    j["film"]["height"] = 16384u;               // unsigned, upper bound
+    j["lights"][0]["radius"] = 1000;            // upper bound inclusive
+    j["surfaces"][0]["normal"] = {0, 2, 0};     // normalised on load
+    j["surfaces"][1]["albedo"] = {0, 1, 0.25};  // albedo bounds inclusive
     j["camera"]["fov_y"] = 179.5;
-    j["camera"]["up"] = {0.5, 3, 0.1};                // need not be orthogonal
+    j["camera"]["up"] = {0.5, 3, 0.1};  // need not be orthogonal
     airlight::Scene s = airlight::parse_scene_json(j);
     CHECK(!s.has_medium);
     CHECK(same(s.background, glm::vec3(0.0f)));

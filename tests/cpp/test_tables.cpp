@@ -1,15 +1,15 @@
 // The scattering tables (cpp/tables.cpp) against independent evaluations, and
 // the error analysis that chose their resolutions (docs/airlight_table.md):
 // run `build/cpp/test_tables --analysis` for the full tables of numbers.
-#include "check.hpp"
-#include "shader_cpp.hpp"
-#include "tables.hpp"
-
 #include <algorithm>
 #include <cmath>
 #include <cstring>
 #include <random>
 #include <vector>
+
+#include "check.hpp"
+#include "shader_cpp.hpp"
+#include "tables.hpp"
 
 using namespace airlight;
 
@@ -107,12 +107,13 @@ double glow_table_error(const Table2D& table, int samples, std::mt19937& rng, do
     const double g00 = std::exp(*std::max_element(table.texels.begin(), table.texels.end()));
     double worst = 0.0;
     for (int i = 0; i < samples; ++i) {
-        const double T = T_lo == 0.0 && unit(rng) < 0.5 ? T_hi * std::pow(10.0, -6.0 * unit(rng))
-                                                         : T_lo + (T_hi - T_lo) * unit(rng);
+        const double T =
+            T_lo == 0.0 && unit(rng) < 0.5 ? T_hi * std::pow(10.0, -6.0 * unit(rng)) : T_lo + (T_hi - T_lo) * unit(rng);
         const double theta = kPi * unit(rng);
         const double exact = surface_glow_exact(T, theta);
         if (exact < 1e-6 * g00) continue;
-        const float G = std::exp(sampler.surface_glow_log_lookup(float(T), float(std::cos(theta)), table.width, table.height));
+        const float G =
+            std::exp(sampler.surface_glow_log_lookup(float(T), float(std::cos(theta)), table.width, table.height));
         worst = std::max(worst, std::abs(G / exact - 1.0));
     }
     return worst;
@@ -151,7 +152,8 @@ void test_glow_limits() {
     const Table2D& t = surface_glow_table();
     const float top_left = t.texels[size_t(t.height - 1) * t.width];
     CHECK(*std::max_element(t.texels.begin(), t.texels.end()) == top_left);
-    CHECK_MSG(std::abs(std::exp(double(top_left)) / surface_glow_exact(0.0, 0.0) - 1.0) < 1e-6, std::to_string(top_left));
+    CHECK_MSG(std::abs(std::exp(double(top_left)) / surface_glow_exact(0.0, 0.0) - 1.0) < 1e-6,
+              std::to_string(top_left));
     CHECK(std::all_of(t.texels.begin(), t.texels.end(), [](float v) { return std::isfinite(v); }));
 }
 
