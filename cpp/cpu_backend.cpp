@@ -35,7 +35,8 @@ struct CpuShader {
 #define HAS_AIRLIGHT (features.airlight)
 #define AIRLIGHT_MARCH (features.airlight_march)
 #define GREY_MEDIUM (features.grey_medium)
-// clang-format off: the same order as the GLSL source (gl_backend.cpp)
+// The same order as the GLSL source (gl_backend.cpp).
+// clang-format off
 #include "geometry.glsl"
 #include "airlight.glsl"
 #include "shading.glsl"
