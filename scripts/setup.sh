@@ -35,5 +35,5 @@ fi
 echo "setup: done ($(.venv/bin/python -c 'import airlight; print("backends:", ", ".join(airlight.available_backends()))'))"
 
 if [ "${1:-}" = "--render" ]; then
-    .venv/bin/airlight-demo --scene scenes/default.json --out airlight.png --exposure 4
+    .venv/bin/airlight-demo --scene scenes/default.json --out airlight.png --exposure 2
 fi
