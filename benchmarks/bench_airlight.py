@@ -66,16 +66,20 @@ def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.
 
 
 # ---- independent reference ---------------------------------------------------
-def camera_rays(scene: dict, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def camera_basis(scene: dict) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, float]:
+    """Position, unit forward, right and up vectors, tan(fov_y / 2) of the pinhole camera."""
     cam = scene["camera"]
-    w, h = scene["film"]["width"], scene["film"]["height"]
     pos = np.array(cam["position"], float)
     fwd = np.array(cam["look_at"], float) - pos
     fwd /= np.linalg.norm(fwd)
     right = np.cross(fwd, cam["up"])
     right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
-    th = math.tan(math.radians(cam["fov_y"]) / 2)
+    return pos, fwd, right, np.cross(right, fwd), math.tan(math.radians(cam["fov_y"]) / 2)
+
+
+def camera_rays(scene: dict, pixels: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+    w, h = scene["film"]["width"], scene["film"]["height"]
+    pos, fwd, right, up, th = camera_basis(scene)
     sx = 2 * (pixels[:, 0] + 0.5) / w - 1
     sy = 1 - 2 * (pixels[:, 1] + 0.5) / h
     d = fwd + (sx * th * w / h)[:, None] * right + (sy * th)[:, None] * up
@@ -141,14 +145,7 @@ def sample_pixels(scene: dict, count: int, rng: np.random.Generator) -> np.ndarr
     images (the halos, where the integrand is most peaked and marching is worst)."""
     width, height = scene["film"]["width"], scene["film"]["height"]
     uniform = np.stack([rng.integers(0, width, count // 2), rng.integers(0, height, count // 2)], axis=1)
-    cam = scene["camera"]
-    pos = np.array(cam["position"], float)
-    fwd = np.array(cam["look_at"], float) - pos
-    fwd /= np.linalg.norm(fwd)
-    right = np.cross(fwd, cam["up"])
-    right /= np.linalg.norm(right)
-    up = np.cross(right, fwd)
-    th = math.tan(math.radians(cam["fov_y"]) / 2)
+    pos, fwd, right, up, th = camera_basis(scene)
     centres = []
     for light in scene["lights"]:
         v = np.array(light["position"], float) - pos
