@@ -16,6 +16,7 @@ struct CpuShader {
     const FrameUniforms& frame;
     const PointLightGpu* point_lights;
     const SurfaceGpu* surfaces;
+    const BvhNodeGpu* bvh_nodes;
     const float* airlight_tail_texels;  // null unless the scene needs the table
     const float* surface_glow_texels;
     Features features;
@@ -28,6 +29,7 @@ struct CpuShader {
     PointLightGpu point_light(int i) const { return point_lights[i]; }
     int surface_count() const { return frame.film_counts.w; }
     SurfaceGpu surface(int i) const { return surfaces[i]; }
+    BvhNodeGpu bvh_node(int i) const { return bvh_nodes[i]; }
 
 #define HAS_MEDIUM (features.medium)
 #define HAS_POINT_LIGHTS (features.point_lights)
@@ -61,6 +63,7 @@ void CpuBackend::render(const FrameData& data, Image& out) {
     const shader::CpuShader program{data.frame,
                                     data.point_lights.data(),
                                     data.surfaces.data(),
+                                    data.bvh_nodes.data(),
                                     data.airlight_tail ? data.airlight_tail->texels.data() : nullptr,
                                     data.surface_glow ? data.surface_glow->texels.data() : nullptr,
                                     data.features};

@@ -7,6 +7,55 @@
 #include <limits>
 
 namespace airlight {
+namespace {
+
+struct BoundedSurface {
+    shader::SurfaceGpu gpu;
+    glm::vec3 lo, hi;
+};
+
+// Median-split bounding volume hierarchy over items [begin, end) into
+// data.bvh_nodes[node] (leaves of at most two surfaces), appending the
+// surfaces to data.surfaces in leaf order. Depth <= log2(n) + 1, well inside
+// the shader's traversal stack (BVH_STACK_SIZE).
+void build_node(std::vector<BoundedSurface>& items, int begin, int end, int node, FrameData& data) {
+    glm::vec3 lo(std::numeric_limits<float>::infinity()), hi(-std::numeric_limits<float>::infinity());
+    glm::vec3 c_lo = lo, c_hi = hi;
+    for (int i = begin; i < end; ++i) {
+        lo = glm::min(lo, items[i].lo);
+        hi = glm::max(hi, items[i].hi);
+        const glm::vec3 c = 0.5f * (items[i].lo + items[i].hi);
+        c_lo = glm::min(c_lo, c);
+        c_hi = glm::max(c_hi, c);
+    }
+    data.bvh_nodes[node].lo = glm::vec4(lo, 0.0f);
+    data.bvh_nodes[node].hi = glm::vec4(hi, 0.0f);
+    if (end - begin <= 2) {
+        data.bvh_nodes[node].info = glm::ivec4(int(data.surfaces.size()), end - begin, 0, 0);
+        for (int i = begin; i < end; ++i) data.surfaces.push_back(items[i].gpu);
+        return;
+    }
+    const glm::vec3 extent = c_hi - c_lo;
+    const int axis = extent.x >= extent.y && extent.x >= extent.z ? 0 : (extent.y >= extent.z ? 1 : 2);
+    const int mid = (begin + end) / 2;
+    std::nth_element(items.begin() + begin, items.begin() + mid, items.begin() + end,
+                     [axis](const BoundedSurface& a, const BoundedSurface& b) {
+                         return a.lo[axis] + a.hi[axis] < b.lo[axis] + b.hi[axis];
+                     });
+    const int left = int(data.bvh_nodes.size());
+    data.bvh_nodes.resize(data.bvh_nodes.size() + 2);
+    data.bvh_nodes[node].info = glm::ivec4(left, 0, 0, 0);
+    build_node(items, begin, mid, left, data);
+    build_node(items, mid, end, left + 1, data);
+}
+
+void build_bvh(std::vector<BoundedSurface>& items, FrameData& data) {
+    if (items.empty()) return;
+    data.bvh_nodes.resize(1);
+    build_node(items, 0, int(items.size()), 0, data);
+}
+
+}  // namespace
 
 FrameData make_frame_data(const Scene& scene) {
     FrameData data;
@@ -60,6 +109,9 @@ FrameData make_frame_data(const Scene& scene) {
         glow_bound = 1.01f * std::exp(*std::max_element(log_glow.begin(), log_glow.end()));
     }
     f.quality = glm::vec4(scene.quality.cull_fraction, float(scene.quality.march_steps), march_far, glow_bound);
+    // Surfaces: the planes (unbounded, tested one by one), then the bounded
+    // surfaces ordered by the leaves of a BVH built over them.
+    std::vector<BoundedSurface> bounded;
     for (const Surface& s : scene.surfaces) {
         shader::SurfaceGpu g{};
         switch (s.type) {
@@ -67,20 +119,25 @@ FrameData make_frame_data(const Scene& scene) {
                 g.p0 = glm::vec4(s.point, 0.0f);
                 g.p1 = glm::vec4(glm::normalize(s.normal), 0.0f);
                 g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_PLANE));
+                data.surfaces.push_back(g);
                 break;
             case SurfaceType::box:
                 g.p0 = glm::vec4(s.box_min, 0.0f);
                 g.p1 = glm::vec4(s.box_max, 0.0f);
                 g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_BOX));
+                bounded.push_back({g, s.box_min, s.box_max});
                 break;
             case SurfaceType::sphere:
                 g.p0 = glm::vec4(s.center, 0.0f);
                 g.p1 = glm::vec4(s.radius, 0.0f, 0.0f, 0.0f);
                 g.albedo_type = glm::vec4(s.albedo, float(shader::SURFACE_SPHERE));
+                bounded.push_back({g, s.center - glm::vec3(s.radius), s.center + glm::vec3(s.radius)});
                 break;
         }
-        data.surfaces.push_back(g);
     }
+    const int planes = int(data.surfaces.size());
+    build_bvh(bounded, data);
+    f.geometry_counts = glm::ivec4(planes, int(data.bvh_nodes.size()), 0, 0);
 
     f.film_counts =
         glm::ivec4(scene.film.width, scene.film.height, int(data.point_lights.size()), int(data.surfaces.size()));

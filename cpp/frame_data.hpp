@@ -12,7 +12,8 @@ namespace airlight {
 struct FrameData {
     shader::FrameUniforms frame{};
     std::vector<shader::PointLightGpu> point_lights;
-    std::vector<shader::SurfaceGpu> surfaces;
+    std::vector<shader::SurfaceGpu> surfaces;   // planes first, then the rest in BVH leaf order
+    std::vector<shader::BvhNodeGpu> bvh_nodes;  // over the bounded surfaces (boxes, spheres)
     shader::Features features;
     // Tables the shader variant reads (null when the scene does not need them:
     // they are then never built).

@@ -195,8 +195,8 @@ struct GlBackend::State {
     EglContext egl;
     std::map<int, GLuint> programs;  // by Features::key()
     GLuint vao = 0, fbo = 0, color = 0;
-    GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0;
-    size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0;
+    GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0, bvh_ssbo = 0;
+    size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0, bvh_capacity = 0;
     int fbo_width = 0, fbo_height = 0;
     std::map<const Table2D*, GLuint> table_textures;  // uploaded once per context
 
@@ -261,6 +261,7 @@ GlBackend::GlBackend() : state_(std::make_unique<State>()) {
     glCreateBuffers(1, &state_->frame_ubo);
     glCreateBuffers(1, &state_->light_ssbo);
     glCreateBuffers(1, &state_->surface_ssbo);
+    glCreateBuffers(1, &state_->bvh_ssbo);
 }
 
 GlBackend::~GlBackend() {
@@ -271,8 +272,8 @@ GlBackend::~GlBackend() {
         glDeleteTextures(1, &state_->color);
         glDeleteFramebuffers(1, &state_->fbo);
         glDeleteVertexArrays(1, &state_->vao);
-        GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo};
-        glDeleteBuffers(3, buffers);
+        GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo};
+        glDeleteBuffers(4, buffers);
         destroy_context(state_->egl);
     }
 }
@@ -300,6 +301,9 @@ void GlBackend::render(const FrameData& data, Image& out) {
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, s.frame_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.light_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.surface_ssbo);
+    upload(s.bvh_ssbo, GL_SHADER_STORAGE_BUFFER, data.bvh_nodes.data(),
+           data.bvh_nodes.size() * sizeof(shader::BvhNodeGpu), s.bvh_capacity);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.bvh_ssbo);
 
     if (data.airlight_tail) glBindTextureUnit(0, s.texture_for(*data.airlight_tail));
     if (data.surface_glow) glBindTextureUnit(1, s.texture_for(*data.surface_glow));

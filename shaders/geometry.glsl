@@ -1,6 +1,6 @@
 // Ray geometry shared by both backends: camera rays and ray/surface
 // intersections. Requires the accessors frame, surface_count(), surface(i),
-// point_light_count(), point_light(i) (declared per backend).
+// bvh_node(i), point_light_count(), point_light(i) (declared per backend).
 
 // Unit direction of the ray through the centre of pixel (x, row), row 0 on top.
 vec3 camera_ray_direction(int x, int row) {
@@ -65,32 +65,78 @@ float intersect_surface(SurfaceGpu s, vec3 origin, vec3 dir, float t_min, OUT(ve
     return t;
 }
 
-// Closest surface along the ray: returns its distance (NO_HIT if none), its
-// index and its normal turned to face the ray origin.
-float trace_surfaces(vec3 origin, vec3 dir, OUT(int) hit_index, OUT(vec3) hit_normal) {
-    float best = NO_HIT;
+// True when the ray segment origin + t dir, t in [0, t_max), meets the box;
+// inv_dir = 1 / dir (safe_inverse), so there is no division by zero.
+bool ray_meets_box(vec3 origin, vec3 inv_dir, vec3 lo, vec3 hi, float t_max) {
+    vec3 ta = (lo - origin) * inv_dir;
+    vec3 tb = (hi - origin) * inv_dir;
+    vec3 t_lo = min(ta, tb);
+    vec3 t_hi = max(ta, tb);
+    float t_near = max(max(t_lo.x, t_lo.y), max(t_lo.z, 0.0f));
+    float t_far = min(min(t_hi.x, t_hi.y), min(t_hi.z, t_max));
+    return t_near <= t_far;
+}
+
+// Nearest surface hit along the ray closer than t_max, or any hit when
+// `any_hit` (shadow rays): planes one by one, the bounded surfaces through the
+// BVH. Returns the distance (NO_HIT if none) with its surface index and
+// geometric normal.
+float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT(int) hit_index, OUT(vec3) hit_normal) {
+    float best = t_max;
     hit_index = -1;
     hit_normal = vec3(0.0f, 1.0f, 0.0f);
-    for (int i = 0; i < surface_count(); ++i) {
+    for (int i = 0; i < frame.geometry_counts.x; ++i) {
         vec3 n;
         float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
         if (t < best) {
             best = t;
             hit_index = i;
             hit_normal = n;
+            if (any_hit) return best;
         }
     }
+    if (frame.geometry_counts.y == 0) return hit_index >= 0 ? best : NO_HIT;
+    vec3 inv_dir = vec3(safe_inverse(dir.x), safe_inverse(dir.y), safe_inverse(dir.z));
+    int stack[BVH_STACK_SIZE];
+    int top = 0;
+    stack[top++] = 0;
+    while (top > 0) {
+        BvhNodeGpu node = bvh_node(stack[--top]);
+        if (!ray_meets_box(origin, inv_dir, vec3(node.lo), vec3(node.hi), best)) continue;
+        if (node.info.y == 0) {
+            if (top + 2 <= BVH_STACK_SIZE) {
+                stack[top++] = node.info.x + 1;
+                stack[top++] = node.info.x;
+            }
+            continue;
+        }
+        for (int i = node.info.x; i < node.info.x + node.info.y; ++i) {
+            vec3 n;
+            float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
+            if (t < best) {
+                best = t;
+                hit_index = i;
+                hit_normal = n;
+                if (any_hit) return best;
+            }
+        }
+    }
+    return hit_index >= 0 ? best : NO_HIT;
+}
+
+// Closest surface along the ray: returns its distance (NO_HIT if none), its
+// index and its normal turned to face the ray origin.
+float trace_surfaces(vec3 origin, vec3 dir, OUT(int) hit_index, OUT(vec3) hit_normal) {
+    float best = trace_surfaces_below(origin, dir, NO_HIT, false, hit_index, hit_normal);
     if (dot(hit_normal, dir) > 0.0f) hit_normal = -hit_normal;
     return best;
 }
 
 // True when any surface blocks the segment origin + t dir, 0 < t < max_t.
 bool segment_occluded(vec3 origin, vec3 dir, float max_t) {
-    for (int i = 0; i < surface_count(); ++i) {
-        vec3 n;
-        if (intersect_surface(surface(i), origin, dir, 0.0f, n) < max_t) return true;
-    }
-    return false;
+    int index;
+    vec3 n;
+    return trace_surfaces_below(origin, dir, max_t, true, index, n) < max_t;
 }
 
 // Distance to the near side of lamp `i`'s sphere along the ray, or NO_HIT.

@@ -13,6 +13,7 @@ struct FrameUniforms {
     vec4 background;       // rgb: radiance of escaping rays, before attenuation
     ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
     vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: bound of G
+    ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting
@@ -31,6 +32,17 @@ struct SurfaceGpu {
     vec4 p1;
     vec4 albedo_type;
 };
+
+// A node of the bounding volume hierarchy over the bounded surfaces (boxes,
+// spheres), built by cpp/frame_data.cpp. Inner node: children first and
+// first + 1; leaf: surfaces [first, first + count).
+struct BvhNodeGpu {
+    vec4 lo;     // xyz: box min
+    vec4 hi;     // xyz: box max
+    ivec4 info;  // x: first, y: count (0 for an inner node)
+};
+
+CONST int BVH_STACK_SIZE = 32;  // depth bound of a median-split tree of < 2^31 surfaces
 
 CONST int SURFACE_PLANE = 0;
 CONST int SURFACE_BOX = 1;

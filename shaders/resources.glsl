@@ -8,6 +8,8 @@ int point_light_count() { return frame.film_counts.z; }
 PointLightGpu point_light(int i) { return point_lights[i]; }
 int surface_count() { return frame.film_counts.w; }
 SurfaceGpu surface(int i) { return surfaces[i]; }
+layout(std430, binding = 3) readonly buffer BvhBlock { BvhNodeGpu bvh_nodes[]; };
+BvhNodeGpu bvh_node(int i) { return bvh_nodes[i]; }
 
 // Scattering tables (cpp/tables.cpp), read texel by texel: the shared code
 // interpolates them itself so that GPU and CPU results agree exactly.

@@ -56,7 +56,28 @@ def _scene(camera, lights, surfaces, medium=FOG, background=(0.0, 0.0, 0.0)) -> 
     return scene
 
 
+def _many_bounded_surfaces(count: int = 40, seed: int = 3) -> list[dict[str, Any]]:
+    """A plane and `count` boxes and spheres scattered over it, so that the renderer's
+    bounding volume hierarchy is several levels deep (camera and shadow rays)."""
+    rng = np.random.default_rng(seed)
+    surfaces = [_plane(albedo=0.4)]
+    for k in range(count):
+        x, z = rng.uniform(-8, 8), rng.uniform(-22, -3)
+        size = rng.uniform(0.3, 1.2)
+        if k % 2:
+            surfaces.append(_sphere((x, size, z), size, float(rng.uniform(0.2, 0.9))))
+        else:
+            surfaces.append(_box((x - size, 0, z - size), (x + size, rng.uniform(0.5, 3), z + size),
+                                 [float(v) for v in rng.uniform(0.2, 0.9, 3)]))
+    return surfaces
+
+
 SCENES: dict[str, dict[str, Any]] = {
+    "forty_boxes_and_spheres_through_the_bvh": _scene(
+        _camera((0, 5, 3), (0, 0, -12)),
+        [_light((3, 6, -8), [90, 80, 70], 0.1), _light((-4, 4, -16), [50, 60, 70], 0.1)],
+        _many_bounded_surfaces(),
+    ),
     "plane_only": _scene(
         _camera((0, 2, 0), (0, 0, -8)),
         [_light((2, 3, -6), [40, 30, 20]), _light((-3, 1.5, -12), 25.0)],
