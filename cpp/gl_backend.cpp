@@ -167,6 +167,8 @@ void upload(GLuint buffer, GLenum target, const void* bytes, size_t size, size_t
     if (size > 0) glBufferSubData(target, 0, GLsizeiptr(size), bytes);
 }
 
+constexpr int kTile = 2048;  // largest tile drawn at once (GlBackend::render)
+
 const char* kGlslPrelude =
     "#version 450 core\n"
     "#define CONST const\n"
@@ -283,44 +285,56 @@ void GlBackend::render(const FrameData& data, Image& out) {
     s.make_current();
     const int width = data.frame.film_counts.x;
     const int height = data.frame.film_counts.y;
+    // The film is drawn in tiles (at most kTile x kTile pixels each): any film
+    // size fits the driver's texture limits, and no single draw runs long
+    // enough to trip a GPU watchdog.
     GLint max_size = 0;
     glGetIntegerv(GL_MAX_TEXTURE_SIZE, &max_size);
-    if (width > max_size || height > max_size) {
-        throw std::runtime_error("airlight: film " + std::to_string(width) + "x" + std::to_string(height) +
-                                 " exceeds this GL driver's maximum texture size " + std::to_string(max_size) +
-                                 "; use the cpu backend");
-    }
-    s.ensure_target(width, height);
+    const int tile = std::min(kTile, int(max_size));
+    const int tile_w = std::min(width, tile), tile_h = std::min(height, tile);
+    s.ensure_target(tile_w, tile_h);
     const GLuint program = s.program_for(data.features);
 
-    upload(s.frame_ubo, GL_UNIFORM_BUFFER, &data.frame, sizeof(data.frame), s.frame_capacity);
+    shader::FrameUniforms frame = data.frame;
+    upload(s.frame_ubo, GL_UNIFORM_BUFFER, &frame, sizeof(frame), s.frame_capacity);
     upload(s.light_ssbo, GL_SHADER_STORAGE_BUFFER, data.point_lights.data(),
            data.point_lights.size() * sizeof(shader::PointLightGpu), s.light_capacity);
     upload(s.surface_ssbo, GL_SHADER_STORAGE_BUFFER, data.surfaces.data(),
            data.surfaces.size() * sizeof(shader::SurfaceGpu), s.surface_capacity);
+    upload(s.bvh_ssbo, GL_SHADER_STORAGE_BUFFER, data.bvh_nodes.data(),
+           data.bvh_nodes.size() * sizeof(shader::BvhNodeGpu), s.bvh_capacity);
     glBindBufferBase(GL_UNIFORM_BUFFER, 0, s.frame_ubo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.light_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.surface_ssbo);
-    upload(s.bvh_ssbo, GL_SHADER_STORAGE_BUFFER, data.bvh_nodes.data(),
-           data.bvh_nodes.size() * sizeof(shader::BvhNodeGpu), s.bvh_capacity);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.bvh_ssbo);
-
     if (data.airlight_tail) glBindTextureUnit(0, s.texture_for(*data.airlight_tail));
     if (data.surface_glow) glBindTextureUnit(1, s.texture_for(*data.surface_glow));
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
-    glViewport(0, 0, width, height);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     glUseProgram(program);
     glBindVertexArray(s.vao);
-    glDrawArrays(GL_TRIANGLES, 0, 3);
 
     out.width = width;
     out.height = height;
     out.rgb.resize(size_t(width) * size_t(height) * 3);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glReadPixels(0, 0, width, height, GL_RGB, GL_FLOAT, out.rgb.data());
+    glPixelStorei(GL_PACK_ROW_LENGTH, width);
+    for (int y0 = 0; y0 < height; y0 += tile_h) {
+        for (int x0 = 0; x0 < width; x0 += tile_w) {
+            const int w = std::min(tile_w, width - x0), h = std::min(tile_h, height - y0);
+            if (x0 > 0 || y0 > 0) {
+                frame.geometry_counts.z = x0;  // pixel offset of this tile (render.frag)
+                frame.geometry_counts.w = y0;
+                glNamedBufferSubData(s.frame_ubo, 0, sizeof(frame), &frame);
+            }
+            glViewport(0, 0, w, h);
+            glDrawArrays(GL_TRIANGLES, 0, 3);
+            glReadPixels(0, 0, w, h, GL_RGB, GL_FLOAT, out.rgb.data() + (size_t(y0) * width + x0) * 3);
+        }
+    }
+    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) throw std::runtime_error("airlight: GL error " + std::to_string(err) + " while rendering");
 }

@@ -13,7 +13,8 @@ struct FrameUniforms {
     vec4 background;       // rgb: radiance of escaping rays, before attenuation
     ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
     vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: bound of G
-    ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces
+    ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces,
+                           // zw: pixel origin of the tile being drawn (GL backend; 0 on the CPU)
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting

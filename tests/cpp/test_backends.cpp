@@ -105,6 +105,19 @@ int test_gl_matches_cpu() {
     scene.film = {33, 17};
     const Image small = gl.render(scene);
     CHECK(small.width == 33 && small.height == 17 && small.rgb.size() == size_t(33 * 17 * 3));
+    // Films larger than one GL tile (2048 pixels) are drawn tile by tile and
+    // must come back seamless, in the right place: compare with the CPU on a
+    // film two tiles wide, and on one two tiles tall.
+    for (Film film : {Film{2100, 20}, Film{20, 2100}}) {
+        Scene tiled = base_scene();
+        tiled.film = film;
+        tiled.camera.fov_y_degrees = 100.0f;
+        const Image a = cpu.render(tiled), b = gl.render(tiled);
+        int compared = 0;
+        const double diff = max_relative_difference(a, b, compared);
+        CHECK_MSG(diff <= 0.005 && compared > 10000,
+                  std::to_string(film.width) + "x" + std::to_string(film.height) + ": " + std::to_string(diff));
+    }
     return 0;
 }
 
