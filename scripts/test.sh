@@ -9,5 +9,6 @@ cmake -S . -B build/cpp -G Ninja -DAIRLIGHT_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Re
 cmake --build build/cpp
 ctest --test-dir build/cpp --output-on-failure
 ruff check python tests benchmarks
+mypy python/airlight
 clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp
 python -m pytest tests/python -q
