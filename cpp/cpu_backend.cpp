@@ -19,12 +19,20 @@ struct CpuShader {
     const BvhNodeGpu* bvh_nodes;
     const float* airlight_tail_texels;  // null unless the scene needs the table
     const float* surface_glow_texels;
+    const float* spot_moment_texels;
+    const SpotLightGpu* spot_lights;
     Features features;
 
     float table_texel(int table, int x, int y) const {
         return table == TABLE_AIRLIGHT_TAIL ? airlight_tail_texels[y * AIRLIGHT_TAIL_NX + x]
                                             : surface_glow_texels[y * SURFACE_GLOW_NX + x];
     }
+    vec4 table_texel4(int, int x, int y) const {
+        const float* t = spot_moment_texels + (size_t(y) * AIRLIGHT_TAIL_NX + size_t(x)) * 4;
+        return vec4(t[0], t[1], t[2], t[3]);
+    }
+    int spot_light_count() const { return frame.light_counts.x; }
+    SpotLightGpu spot_light(int i) const { return spot_lights[i]; }
     int point_light_count() const { return frame.film_counts.z; }
     PointLightGpu point_light(int i) const { return point_lights[i]; }
     int surface_count() const { return frame.film_counts.w; }
@@ -37,10 +45,13 @@ struct CpuShader {
 #define HAS_AIRLIGHT (features.airlight)
 #define AIRLIGHT_MARCH (features.airlight_march)
 #define GREY_MEDIUM (features.grey_medium)
+#define HAS_SPOT_LIGHTS (features.spot_lights)
+#define HAS_SPOT_AIRLIGHT (features.spot_airlight)
 // The same order as the GLSL source (gl_backend.cpp).
 // clang-format off
 #include "geometry.glsl"
 #include "airlight.glsl"
+#include "spot.glsl"
 #include "shading.glsl"
 // clang-format on
 #undef HAS_MEDIUM
@@ -49,6 +60,8 @@ struct CpuShader {
 #undef HAS_AIRLIGHT
 #undef AIRLIGHT_MARCH
 #undef GREY_MEDIUM
+#undef HAS_SPOT_LIGHTS
+#undef HAS_SPOT_AIRLIGHT
 };
 
 }  // namespace shader
@@ -66,6 +79,8 @@ void CpuBackend::render(const FrameData& data, Image& out) {
                                     data.bvh_nodes.data(),
                                     data.airlight_tail ? data.airlight_tail->texels.data() : nullptr,
                                     data.surface_glow ? data.surface_glow->texels.data() : nullptr,
+                                    data.spot_moments ? data.spot_moments->texels.data() : nullptr,
+                                    data.spot_lights.data(),
                                     data.features};
     std::atomic<int> next_row{0};
     auto worker = [&]() {

@@ -95,6 +95,26 @@ FrameData make_frame_data(const Scene& scene) {
         farthest = std::max(farthest, glm::length(light.position - cam.position));
         data.point_lights.push_back({glm::vec4(light.position, light.radius), glm::vec4(light.intensity, 0.0f)});
     }
+    // Spotlights: what loses precision in float32 (the position relative to
+    // the camera, sin^2 A, 1 - cos A) is formed in double (docs/spot_table.md).
+    for (const SpotLight& spot : scene.spot_lights) {
+        const glm::dvec3 relative = glm::dvec3(spot.position) - glm::dvec3(cam.position);
+        const glm::dvec3 axis = glm::normalize(glm::dvec3(spot.direction));
+        const double angle = glm::radians(double(spot.cone_angle_degrees));
+        const double sin_half = std::sin(0.5 * angle), one_minus_cos = 2.0 * sin_half * sin_half;
+        const double q = spot.edge;
+        shader::SpotLightGpu g{};
+        g.relative_position_radius = glm::vec4(glm::vec3(relative), spot.radius);
+        g.world_position = glm::vec4(spot.position, 0.0f);
+        g.axis_cos = glm::vec4(glm::vec3(axis), float(std::cos(angle)));
+        g.intensity_edge = glm::vec4(spot.intensity, float(q));
+        g.cone = glm::vec4(float(std::sin(angle) * std::sin(angle)), float(one_minus_cos),
+                           float((1.0 - q) / one_minus_cos), 0.0f);
+        data.spot_lights.push_back(g);
+        farthest = std::max(farthest, float(glm::length(relative)));
+    }
+    f.light_counts = glm::ivec4(int(data.spot_lights.size()), 0, 0, 0);
+
     // Ray marching (benchmarks): escaping rays are cut where the transmittance
     // of the thinnest scattering channel has fallen below e^{-16}.
     float thinnest = std::numeric_limits<float>::infinity();
@@ -148,6 +168,11 @@ FrameData make_frame_data(const Scene& scene) {
     data.features.airlight_march = data.features.airlight && scene.quality.airlight == AirlightMethod::march;
     data.features.grey_medium =
         sigma_t.x == sigma_t.y && sigma_t.y == sigma_t.z && sigma_s.x == sigma_s.y && sigma_s.y == sigma_s.z;
+    data.features.spot_lights = !data.spot_lights.empty();
+    data.features.spot_airlight = scattering && !data.spot_lights.empty();
+    data.features.airlight_march =
+        (data.features.airlight || data.features.spot_airlight) && scene.quality.airlight == AirlightMethod::march;
+    if (data.features.spot_airlight && !data.features.airlight_march) data.spot_moments = &spot_moment_table();
     if (data.features.airlight) {
         data.surface_glow = &surface_glow_table();
         if (!data.features.airlight_march) data.airlight_tail = &airlight_tail_table();

@@ -14,11 +14,13 @@ struct FrameData {
     std::vector<shader::PointLightGpu> point_lights;
     std::vector<shader::SurfaceGpu> surfaces;   // planes first, then the rest in BVH leaf order
     std::vector<shader::BvhNodeGpu> bvh_nodes;  // over the bounded surfaces (boxes, spheres)
+    std::vector<shader::SpotLightGpu> spot_lights;
     shader::Features features;
     // Tables the shader variant reads (null when the scene does not need them:
     // they are then never built).
     const Table2D* airlight_tail = nullptr;
     const Table2D* surface_glow = nullptr;
+    const Table2D* spot_moments = nullptr;
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and

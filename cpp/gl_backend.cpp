@@ -185,8 +185,10 @@ std::string fragment_shader_source(const shader::Features& features) {
     source += std::string("#define HAS_AIRLIGHT ") + (features.airlight ? "true" : "false") + "\n";
     source += std::string("#define AIRLIGHT_MARCH ") + (features.airlight_march ? "true" : "false") + "\n";
     source += std::string("#define GREY_MEDIUM ") + (features.grey_medium ? "true" : "false") + "\n";
+    source += std::string("#define HAS_SPOT_LIGHTS ") + (features.spot_lights ? "true" : "false") + "\n";
+    source += std::string("#define HAS_SPOT_AIRLIGHT ") + (features.spot_airlight ? "true" : "false") + "\n";
     for (const char* name : {"constants.glsl", "layout.glsl", "resources.glsl", "geometry.glsl", "airlight.glsl",
-                             "shading.glsl", "render.frag"}) {
+                             "spot.glsl", "shading.glsl", "render.frag"}) {
         source += "// ---- " + std::string(name) + "\n";
         source += shader_source(name);
     }
@@ -197,8 +199,8 @@ struct GlBackend::State {
     EglContext egl;
     std::map<int, GLuint> programs;  // by Features::key()
     GLuint vao = 0, fbo = 0, color = 0;
-    GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0, bvh_ssbo = 0;
-    size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0, bvh_capacity = 0;
+    GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0, bvh_ssbo = 0, spot_ssbo = 0;
+    size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0, bvh_capacity = 0, spot_capacity = 0;
     int fbo_width = 0, fbo_height = 0;
     std::map<const Table2D*, GLuint> table_textures;  // uploaded once per context
 
@@ -208,10 +210,11 @@ struct GlBackend::State {
         if (it != table_textures.end()) return it->second;
         GLuint tex = 0;
         glCreateTextures(GL_TEXTURE_2D, 1, &tex);
-        glTextureStorage2D(tex, 1, GL_R32F, table.width, table.height);
+        glTextureStorage2D(tex, 1, table.channels == 4 ? GL_RGBA32F : GL_R32F, table.width, table.height);
         glTextureParameteri(tex, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
         glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-        glTextureSubImage2D(tex, 0, 0, 0, table.width, table.height, GL_RED, GL_FLOAT, table.texels.data());
+        glTextureSubImage2D(tex, 0, 0, 0, table.width, table.height, table.channels == 4 ? GL_RGBA : GL_RED, GL_FLOAT,
+                            table.texels.data());
         table_textures[&table] = tex;
         return tex;
     }
@@ -264,6 +267,7 @@ GlBackend::GlBackend() : state_(std::make_unique<State>()) {
     glCreateBuffers(1, &state_->light_ssbo);
     glCreateBuffers(1, &state_->surface_ssbo);
     glCreateBuffers(1, &state_->bvh_ssbo);
+    glCreateBuffers(1, &state_->spot_ssbo);
 }
 
 GlBackend::~GlBackend() {
@@ -274,8 +278,9 @@ GlBackend::~GlBackend() {
         glDeleteTextures(1, &state_->color);
         glDeleteFramebuffers(1, &state_->fbo);
         glDeleteVertexArrays(1, &state_->vao);
-        GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo};
-        glDeleteBuffers(4, buffers);
+        GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo,
+                            state_->spot_ssbo};
+        glDeleteBuffers(5, buffers);
         destroy_context(state_->egl);
     }
 }
@@ -307,8 +312,12 @@ void GlBackend::render(const FrameData& data, Image& out) {
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 1, s.light_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 2, s.surface_ssbo);
     glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 3, s.bvh_ssbo);
+    upload(s.spot_ssbo, GL_SHADER_STORAGE_BUFFER, data.spot_lights.data(),
+           data.spot_lights.size() * sizeof(shader::SpotLightGpu), s.spot_capacity);
+    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, 4, s.spot_ssbo);
     if (data.airlight_tail) glBindTextureUnit(0, s.texture_for(*data.airlight_tail));
     if (data.surface_glow) glBindTextureUnit(1, s.texture_for(*data.surface_glow));
+    if (data.spot_moments) glBindTextureUnit(2, s.texture_for(*data.spot_moments));
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glDisable(GL_DEPTH_TEST);

@@ -31,13 +31,13 @@ constexpr double max_light_radius = 1e3;
 constexpr double default_light_radius = 0.05;
 constexpr double infinity = std::numeric_limits<double>::infinity();
 
-enum class LightType { point };
+enum class LightType { point, spot };
 
 template <class E>
 using NameTable = std::vector<std::pair<const char*, E>>;
 
 const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic}};
-const NameTable<LightType> light_types{{"point", LightType::point}};
+const NameTable<LightType> light_types{{"point", LightType::point}, {"spot", LightType::spot}};
 const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic},
                                                  {"march", AirlightMethod::march}};
 const NameTable<SurfaceType> surface_types{
@@ -310,15 +310,69 @@ Medium parse_medium(const Obj& o) {
     return m;
 }
 
-PointLight parse_light(const Obj& o) {
-    read_enum(o.req("type"), "light", light_types);
+// A direction: nonzero, stored unit. Directions already unit to float
+// precision are kept as given, so that reloading a written scene gives the
+// same bits.
+glm::vec3 read_direction(const Value& v, const char* zero_message) {
+    glm::dvec3 d(read_vec3(v));
+    double length = glm::length(d);
+    if (length < 1e-12) fail(Kind::value, v.field, zero_message);
+    return std::abs(length - 1.0) > 1e-6 ? glm::vec3(d / length) : glm::vec3(d);
+}
+
+float read_light_radius(const Obj& o) {
+    if (auto v = o.opt("radius")) return read_positive(*v, max_light_radius, true);
+    return static_cast<float>(default_light_radius);
+}
+
+PointLight parse_point_light(const Obj& o) {
     o.check_keys({"type", "position", "intensity", "radius"});
     PointLight l;
     l.position = read_vec3(o.req("position"));
     l.intensity = read_rgb(o.req("intensity"));
-    l.radius = static_cast<float>(default_light_radius);
-    if (auto v = o.opt("radius")) l.radius = read_positive(*v, max_light_radius, true);
+    l.radius = read_light_radius(o);
     return l;
+}
+
+// Spot light (MODELS.md section 2): cone_angle is the half-angle in degrees,
+// in (0, 90] (checked on the float value too); edge in [0, 1].
+SpotLight parse_spot_light(const Obj& o) {
+    o.check_keys({"type", "position", "direction", "intensity", "cone_angle", "edge", "radius"});
+    SpotLight l;
+    l.position = read_vec3(o.req("position"));
+    l.direction = read_direction(o.req("direction"), "must not be zero");
+    l.intensity = read_rgb(o.req("intensity"));
+    Value cone = o.req("cone_angle");
+    double angle = read_number(cone);
+    float angle_f = static_cast<float>(angle);
+    if (!(angle > 0 && angle_f > 0 && angle <= 90 && angle_f <= 90))
+        fail(Kind::value, cone.field, "must be in (0, 90]");
+    l.cone_angle_degrees = angle_f;
+    if (auto v = o.opt("edge")) {
+        double edge = read_number(*v);
+        if (edge < 0 || edge > 1) fail(Kind::value, v->field, "must be in [0, 1]");
+        l.edge = static_cast<float>(edge);
+    }
+    l.radius = read_light_radius(o);
+    return l;
+}
+
+// The "lights" list: point entries go to point_lights, spot entries to
+// spot_lights; field paths keep the index in the list.
+void parse_lights(const std::optional<Value>& v, Scene& s) {
+    if (!v) return;
+    if (!v->j.is_array()) fail(Kind::type, v->field, "expected a list, got " + type_name(v->j));
+    for (std::size_t i = 0; i < v->j.size(); ++i) {
+        Obj o(Value{v->j[i], index_path(v->field, i)});
+        switch (read_enum(o.req("type"), "light", light_types)) {
+            case LightType::point:
+                s.point_lights.push_back(parse_point_light(o));
+                break;
+            case LightType::spot:
+                s.spot_lights.push_back(parse_spot_light(o));
+                break;
+        }
+    }
 }
 
 Surface parse_surface(const Obj& o) {
@@ -329,13 +383,7 @@ Surface parse_surface(const Obj& o) {
     switch (s.type) {
         case SurfaceType::plane: {
             s.point = read_vec3(o.req("point"));
-            Value nv = o.req("normal");
-            glm::dvec3 n(read_vec3(nv));
-            double length = glm::length(n);
-            if (length < 1e-12) fail(Kind::value, nv.field, "normal must be nonzero");
-            // Normals already unit to float precision are kept, so that reloading
-            // a written scene gives the same bits.
-            s.normal = std::abs(length - 1.0) > 1e-6 ? glm::vec3(n / length) : glm::vec3(n);
+            s.normal = read_direction(o.req("normal"), "normal must be nonzero");
             break;
         }
         case SurfaceType::box: {
@@ -396,7 +444,7 @@ Scene parse_scene_json(const json& j) {
         s.has_medium = true;
         s.medium = parse_medium(Obj(*v));
     }
-    s.point_lights = read_list<PointLight>(top.opt("lights"), parse_light);
+    parse_lights(top.opt("lights"), s);
     s.surfaces = read_list<Surface>(top.opt("surfaces"), parse_surface);
     if (auto v = top.opt("background")) s.background = read_rgb(*v);
     if (auto v = top.opt("quality")) s.quality = parse_quality(Obj(*v));
@@ -422,6 +470,15 @@ json scene_to_json_value(const Scene& s) {
         j["lights"].push_back({{"type", name_of(light_types, LightType::point)},
                                {"position", json_vec3(l.position)},
                                {"intensity", json_vec3(l.intensity)},
+                               {"radius", json_number(l.radius)}});
+    }
+    for (const auto& l : s.spot_lights) {
+        j["lights"].push_back({{"type", name_of(light_types, LightType::spot)},
+                               {"position", json_vec3(l.position)},
+                               {"direction", json_vec3(l.direction)},
+                               {"intensity", json_vec3(l.intensity)},
+                               {"cone_angle", json_number(l.cone_angle_degrees)},
+                               {"edge", json_number(l.edge)},
                                {"radius", json_number(l.radius)}});
     }
     j["surfaces"] = json::array();

@@ -26,10 +26,12 @@ struct Features {
     bool airlight = false;        // point lights in a scattering medium: airlight and surface glow
     bool airlight_march = false;  // brute-force ray marching instead of the tables (benchmarks)
     bool grey_medium = false;     // sigma_t and sigma_s equal on all channels: one evaluation, not three
+    bool spot_lights = false;     // spotlights: direct light and cores
+    bool spot_airlight = false;   // spotlights in a scattering medium
 
     int key() const {
         return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |
-               (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0);
+               (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0) | (spot_lights ? 64 : 0) | (spot_airlight ? 128 : 0);
     }
 };
 

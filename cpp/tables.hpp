@@ -13,6 +13,7 @@ struct Table2D {
     const char* name = "";
     int width = 0;
     int height = 0;
+    int channels = 1;  // texels per grid node (1: R32F, 4: RGBA32F)
     std::vector<float> texels;
     double build_seconds = 0.0;
 };
@@ -39,6 +40,9 @@ Table2D build_surface_glow_table(int width, int height);
 // The tables, built on first use (thread safe) and kept for the process.
 const Table2D& airlight_tail_table();
 const Table2D& surface_glow_table();
+// Spot local moments (docs/spot_table.md): RGBA (S, M1/N1, M2/N2, 0) on the
+// airlight tail's grid.
+const Table2D& spot_moment_table();
 
 // The tables built so far in this process, by name (for tests showing that a
 // scene which does not need a table builds none, and for reporting memory).

@@ -19,6 +19,27 @@ float table_bilinear(int table, int nx, int ny, float X, float Y) {
     return mix(bottom, top, ay);
 }
 
+// True when a contribution bounded by `bound` is provably below the culling
+// fraction of `so_far`, a lower bound of the final value, on every channel
+// (docs/culling.md): skipping it changes the result by less than that fraction.
+bool negligible(vec3 bound, vec3 so_far) {
+    vec3 limit = frame.quality.x * so_far;
+    return bound.x < limit.x && bound.y < limit.y && bound.z < limit.z;
+}
+
+// The same for a table of four channels (RGBA texels, table_texel4).
+vec4 table_bilinear4(int table, int nx, int ny, float X, float Y) {
+    float fx = clamp(X, 0.0f, 1.0f) * float(nx - 1);
+    float fy = clamp(Y, 0.0f, 1.0f) * float(ny - 1);
+    int ix = min(int(fx), nx - 2);
+    int iy = min(int(fy), ny - 2);
+    float ax = fx - float(ix);
+    float ay = fy - float(iy);
+    vec4 bottom = mix(table_texel4(table, ix, iy), table_texel4(table, ix + 1, iy), ax);
+    vec4 top = mix(table_texel4(table, ix, iy + 1), table_texel4(table, ix + 1, iy + 1), ax);
+    return mix(bottom, top, ay);
+}
+
 // ---- Airlight along a view ray -------------------------------------------
 // Geometry of one light relative to the ray o + x d: b = (S - o).d is the
 // distance along the ray to the closest approach, h > 0 the closest distance.

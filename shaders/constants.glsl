@@ -26,3 +26,8 @@ CONST int SURFACE_GLOW_NY = 128;
 CONST float SURFACE_GLOW_T_MAX = 200.0f;
 CONST float SURFACE_GLOW_T_SCALE = 0.05f;
 
+
+// Spot moments (docs/spot_table.md): RGBA texel (S, M1/N1, M2/N2, 0) on the
+// airlight tail's grid, M1 = <sin 2(xi - v)>, M2 = <sin^2(xi - v)> the local
+// moments of the normalised tail weight, N1 = cv/(1 + lam cv/2), N2 = N1^2/2.
+CONST int TABLE_SPOT_MOMENTS = 2;

@@ -15,6 +15,7 @@ struct FrameUniforms {
     vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: bound of G
     ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces,
                            // zw: pixel origin of the tile being drawn (GL backend; 0 on the CPU)
+    ivec4 light_counts;    // x: spot lights
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting
@@ -22,6 +23,19 @@ struct FrameUniforms {
 struct PointLightGpu {
     vec4 position_radius;  // xyz: centre, w: radius (m)
     vec4 intensity;        // rgb: W/sr
+};
+
+// A spotlight (MODELS.md section 2): profile I(theta) = I0 [(1 - q)(cos theta -
+// cos A)/(1 - cos A) + q] for theta <= A, theta measured from the axis; a
+// sphere of radius r like a point lamp. Quantities that lose precision in
+// float32 (position relative to the camera, sin^2 A, 1 - cos A) are formed in
+// double on the CPU (docs/spot_table.md, section 4).
+struct SpotLightGpu {
+    vec4 relative_position_radius;  // xyz: S - camera position, w: radius (m)
+    vec4 world_position;            // xyz: S
+    vec4 axis_cos;                  // xyz: unit axis a, w: cos A
+    vec4 intensity_edge;            // rgb: I0 (W/sr on the axis), w: edge softness q
+    vec4 cone;                      // x: sin^2 A, y: 1 - cos A, z: beta = (1 - q) / (1 - cos A)
 };
 
 // A Lambertian surface. type (albedo_type.w, exact small integer):

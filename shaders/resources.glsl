@@ -9,14 +9,20 @@ PointLightGpu point_light(int i) { return point_lights[i]; }
 int surface_count() { return frame.film_counts.w; }
 SurfaceGpu surface(int i) { return surfaces[i]; }
 layout(std430, binding = 3) readonly buffer BvhBlock { BvhNodeGpu bvh_nodes[]; };
+layout(std430, binding = 4) readonly buffer SpotLightBlock { SpotLightGpu spot_lights[]; };
+int spot_light_count() { return frame.light_counts.x; }
+SpotLightGpu spot_light(int i) { return spot_lights[i]; }
 BvhNodeGpu bvh_node(int i) { return bvh_nodes[i]; }
 
 // Scattering tables (cpp/tables.cpp), read texel by texel: the shared code
 // interpolates them itself so that GPU and CPU results agree exactly.
 layout(binding = 0) uniform sampler2D airlight_tail_texels;
 layout(binding = 1) uniform sampler2D surface_glow_texels;
+layout(binding = 2) uniform sampler2D spot_moment_texels;
 
 float table_texel(int table, int x, int y) {
     if (table == TABLE_AIRLIGHT_TAIL) return texelFetch(airlight_tail_texels, ivec2(x, y), 0).r;
     return texelFetch(surface_glow_texels, ivec2(x, y), 0).r;
 }
+
+vec4 table_texel4(int table, int x, int y) { return texelFetch(spot_moment_texels, ivec2(x, y), 0); }

@@ -39,14 +39,6 @@ vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos
                 scaled_surface_glow(scale.z, sigma_t.z * dist, cos_theta_s));
 }
 
-// True when a contribution bounded by `bound` is provably below the culling
-// fraction of `so_far`, a lower bound of the final value, on every channel
-// (docs/culling.md): skipping it changes the result by less than that fraction.
-bool negligible(vec3 bound, vec3 so_far) {
-    vec3 limit = frame.quality.x * so_far;
-    return bound.x < limit.x && bound.y < limit.y && bound.z < limit.z;
-}
-
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
 // lamps: inverse-square falloff, Lambert's cosine, attenuation exp(-sigma_t d)
 // along the lamp-to-point path and hard shadows from every surface; plus, in
@@ -72,6 +64,33 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         if (negligible(direct + glow_bound, irradiance)) continue;
         if (HAS_AIRLIGHT) irradiance += surface_glow_irradiance(intensity, dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
+        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
+        irradiance += direct;
+    }
+    return irradiance;
+}
+
+// Irradiance at p (normal n) from the spotlights: the profile in the direction
+// of p, inverse-square falloff, Lambert's cosine, attenuation and hard shadows
+// (MODELS.md section 2). The light spots scatter onto surfaces (their glow)
+// is not modelled yet.
+vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
+    vec3 irradiance = vec3(0.0f);
+    vec3 shadow_origin = p + surface_offset(p) * n;
+    for (int i = 0; i < spot_light_count(); ++i) {
+        SpotLightGpu s = spot_light(i);
+        vec3 to_light = vec3(s.world_position) - p;
+        float dist2 = dot(to_light, to_light);
+        float dist = sqrt(dist2);
+        float radius = s.relative_position_radius.w;
+        if (dist <= 0.0f) continue;
+        vec3 l = to_light / dist;
+        float cos_theta = dot(n, l);
+        if (cos_theta <= 0.0f) continue;
+        float profile = spot_profile_toward(s, -l);
+        if (profile <= 0.0f) continue;
+        vec3 direct = vec3(s.intensity_edge) * (profile * cos_theta / max(dist2, radius * radius)) * transmittance(dist);
+        if (negligible(direct, irradiance + so_far)) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
         irradiance += direct;
     }
@@ -133,8 +152,10 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     float t_hit = NO_HIT;
     if (HAS_SURFACES) t_hit = trace_surfaces(origin, dir, hit_index, normal);
 
-    // Lamp cores: the nearest lamp sphere in front of the first surface.
+    // Lamp cores: the nearest lamp sphere in front of the first surface. A
+    // spot's core shows its profile in the direction of the camera.
     int lamp_index = -1;
+    int spot_index = -1;
     if (HAS_POINT_LIGHTS) {
         for (int i = 0; i < point_light_count(); ++i) {
             float t = intersect_lamp(point_light(i), origin, dir);
@@ -145,8 +166,27 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         }
     }
 
+    if (HAS_SPOT_LIGHTS) {
+        for (int i = 0; i < spot_light_count(); ++i) {
+            SpotLightGpu s = spot_light(i);
+            PointLightGpu sphere;
+            sphere.position_radius = vec4(vec3(s.world_position), s.relative_position_radius.w);
+            sphere.intensity = s.intensity_edge;
+            float t = intersect_lamp(sphere, origin, dir);
+            if (t < t_hit) {
+                t_hit = t;
+                spot_index = i;
+                lamp_index = -1;
+            }
+        }
+    }
+
     vec3 radiance;
-    if (lamp_index >= 0) {
+    if (spot_index >= 0) {
+        SpotLightGpu s = spot_light(spot_index);
+        float r = s.relative_position_radius.w;
+        radiance = vec3(s.intensity_edge) * (spot_profile_toward(s, normalize(-vec3(s.relative_position_radius))) / (PI * r * r));
+    } else if (lamp_index >= 0) {
         PointLightGpu lamp = point_light(lamp_index);
         float r = lamp.position_radius.w;
         radiance = vec3(lamp.intensity) / (PI * r * r);
@@ -157,6 +197,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         // A black surface reflects nothing: skip its lighting (and shadow rays).
         bool black = albedo.x == 0.0f && albedo.y == 0.0f && albedo.z == 0.0f;
         if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal);
+        if (HAS_SPOT_LIGHTS && !black) irradiance += spot_light_irradiance(p, normal, irradiance);
         radiance = albedo / PI * irradiance;
     } else {
         radiance = vec3(frame.background);
@@ -168,6 +209,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         for (int i = 0; i < point_light_count(); ++i) {
             radiance += point_light_airlight(point_light(i), origin, dir, t_hit, radiance);
         }
+    }
+    if (HAS_SPOT_AIRLIGHT) {
+        for (int i = 0; i < spot_light_count(); ++i) radiance += spot_light_airlight(spot_light(i), dir, t_hit, radiance);
     }
     return radiance;
 }

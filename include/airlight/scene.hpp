@@ -50,6 +50,20 @@ struct PointLight {
     float radius = 0.05f;
 };
 
+// Spot light (MODELS.md section 2): a lamp at `position` shining along the unit
+// `direction` with intensity (W/sr) I0 on the axis and, at angle theta from it,
+//   I(theta) = I0 [(1 - edge) (cos theta - cos A) / (1 - cos A) + edge]
+// for theta <= A = cone_angle_degrees (the half-angle, in (0, 90]), else 0.
+// The lamp is a small emitting sphere of the given radius, as for PointLight.
+struct SpotLight {
+    glm::vec3 position{0.0f};
+    glm::vec3 direction{0.0f, -1.0f, 0.0f};
+    Rgb intensity{0.0f};
+    float cone_angle_degrees = 30.0f;
+    float edge = 0.0f;
+    float radius = 0.05f;
+};
+
 enum class SurfaceType { plane, box, sphere };
 
 // Lambertian surfaces. Field use by type:
@@ -89,6 +103,7 @@ struct Scene {
     bool has_medium = false;  // false: clear air
     Medium medium;
     std::vector<PointLight> point_lights;
+    std::vector<SpotLight> spot_lights;
     std::vector<Surface> surfaces;
     Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium)
     Quality quality;

@@ -44,11 +44,19 @@ const char* readme_example =
     R"("plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": [0.3, 0.3, 0.3]}, {"type": "box", "min": )"
     R"([-8, 0, -40], "max": [-4, 12, -25], "albedo": 0.5}], "background": [0, 0, 0]})";
 
-// The README example plus a sphere (surfaces[2]) and a second light.
+// A spot light with every key given.
+json spot_light() {
+    return {{"type", "spot"},   {"position", {1, 4, -8}}, {"direction", {0, -1, 0}}, {"intensity", {500, 450, 400}},
+            {"cone_angle", 25}, {"edge", 0.15},           {"radius", 0.08}};
+}
+
+// The README example plus a sphere (surfaces[2]), a second point light and a
+// spot light (lights[2]).
 json base_scene() {
     json j = json::parse(readme_example);
     j["surfaces"].push_back({{"type", "sphere"}, {"center", {0, 1, -15}}, {"radius", 1.5}});
     j["lights"].push_back({{"type", "point"}, {"position", {0, 3, -5}}, {"intensity", 10}, {"radius", 0.1}});
+    j["lights"].push_back(spot_light());
     return j;
 }
 
@@ -60,7 +68,8 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
               same(a.camera.position, b.camera.position) && same(a.camera.look_at, b.camera.look_at) &&
               same(a.camera.up, b.camera.up) && a.camera.fov_y_degrees == b.camera.fov_y_degrees &&
               a.has_medium == b.has_medium && same(a.background, b.background) &&
-              a.point_lights.size() == b.point_lights.size() && a.surfaces.size() == b.surfaces.size();
+              a.point_lights.size() == b.point_lights.size() && a.spot_lights.size() == b.spot_lights.size() &&
+              a.surfaces.size() == b.surfaces.size();
     if (!ok) return false;
     if (a.has_medium && !(same(a.medium.sigma_t, b.medium.sigma_t) && same(a.medium.albedo, b.medium.albedo) &&
                           a.medium.phase.type == b.medium.phase.type))
@@ -68,6 +77,12 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
     for (std::size_t i = 0; i < a.point_lights.size(); ++i) {
         const auto &x = a.point_lights[i], &y = b.point_lights[i];
         if (!(same(x.position, y.position) && same(x.intensity, y.intensity) && x.radius == y.radius)) return false;
+    }
+    for (std::size_t i = 0; i < a.spot_lights.size(); ++i) {
+        const auto &x = a.spot_lights[i], &y = b.spot_lights[i];
+        if (!(same(x.position, y.position) && same(x.direction, y.direction) && same(x.intensity, y.intensity) &&
+              x.cone_angle_degrees == y.cone_angle_degrees && x.edge == y.edge && x.radius == y.radius))
+            return false;
     }
     for (std::size_t i = 0; i < a.surfaces.size(); ++i) {
         const auto &x = a.surfaces[i], &y = b.surfaces[i];
@@ -258,7 +273,8 @@ const std::vector<BadCase> bad_cases = {
     {"light not object", [](json& j) { j["lights"][0] = 5; }, Kind::type, "lights[0]", "expected an object"},
     {"light type missing", [](json& j) { j["lights"][0].erase("type"); }, Kind::value, "lights[0].type",
      "missing required key"},
-    {"light type unknown", [](json& j) { j["lights"][0]["type"] = "spot"; }, Kind::value, "lights[0].type", "point"},
+    {"light type unknown", [](json& j) { j["lights"][0]["type"] = "area"; }, Kind::value, "lights[0].type",
+     "unknown light type 'area'; allowed: point, spot"},
     {"light type number", [](json& j) { j["lights"][0]["type"] = 1; }, Kind::type, "lights[0].type",
      "expected a string"},
     {"light position missing", [](json& j) { j["lights"][0].erase("position"); }, Kind::value, "lights[0].position",
@@ -296,9 +312,120 @@ const std::vector<BadCase> bad_cases = {
     {"light extra key", [](json& j) { j["lights"][0]["colour"] = 1; }, Kind::value, "lights[0].colour", "unknown key"},
     {"light typo", [](json& j) { j["lights"][0]["intensty"] = 1; }, Kind::value, "lights[0].intensty",
      "did you mean 'intensity'?"},
-    {"third light",
+    {"fourth light",
      [](json& j) { j["lights"].push_back({{"type", "point"}, {"position", {0, 0, 0}}, {"intensity", {1, -2, 3}}}); },
-     Kind::value, "lights[2].intensity", "must be >= 0"},
+     Kind::value, "lights[3].intensity", "must be >= 0"},
+    {"point with direction",
+     [](json& j) {
+         j["lights"][0]["direction"] = {0, -1, 0};
+     },
+     Kind::value, "lights[0].direction", "unknown key"},
+    {"point with cone_angle", [](json& j) { j["lights"][1]["cone_angle"] = 30; }, Kind::value, "lights[1].cone_angle",
+     "unknown key"},
+    {"point with edge", [](json& j) { j["lights"][1]["edge"] = 0.5; }, Kind::value, "lights[1].edge", "unknown key"},
+    // Spot lights (lights[2] is a spot).
+    {"spot position missing", [](json& j) { j["lights"][2].erase("position"); }, Kind::value, "lights[2].position",
+     "missing required key"},
+    {"spot direction missing", [](json& j) { j["lights"][2].erase("direction"); }, Kind::value, "lights[2].direction",
+     "missing required key"},
+    {"spot intensity missing", [](json& j) { j["lights"][2].erase("intensity"); }, Kind::value, "lights[2].intensity",
+     "missing required key"},
+    {"spot cone_angle missing", [](json& j) { j["lights"][2].erase("cone_angle"); }, Kind::value,
+     "lights[2].cone_angle", "missing required key"},
+    {"spot direction zero",
+     [](json& j) {
+         j["lights"][2]["direction"] = {0, 0, 0};
+     },
+     Kind::value, "lights[2].direction", "must not be zero"},
+    {"spot direction tiny",
+     [](json& j) {
+         j["lights"][2]["direction"] = {0, -1e-13, 0};
+     },
+     Kind::value, "lights[2].direction", "must not be zero"},
+    {"spot direction short",
+     [](json& j) {
+         j["lights"][2]["direction"] = {0, -1};
+     },
+     Kind::value, "lights[2].direction", "exactly 3"},
+    {"spot direction string", [](json& j) { j["lights"][2]["direction"] = "down"; }, Kind::type, "lights[2].direction",
+     "expected a list"},
+    {"spot direction NaN",
+     [](json& j) {
+         j["lights"][2]["direction"] = {0, nan, -1};
+     },
+     Kind::value, "lights[2].direction", "must be finite"},
+    {"spot direction bool elem",
+     [](json& j) {
+         j["lights"][2]["direction"] = {0, true, 0};
+     },
+     Kind::type, "lights[2].direction", "expected a number, got boolean"},
+    {"spot position absurd",
+     [](json& j) {
+         j["lights"][2]["position"] = {0, 0, 2e7};
+     },
+     Kind::value, "lights[2].position", "absurd coordinate"},
+    {"spot intensity negative", [](json& j) { j["lights"][2]["intensity"] = -1; }, Kind::value, "lights[2].intensity",
+     "must be >= 0"},
+    {"spot cone_angle 0", [](json& j) { j["lights"][2]["cone_angle"] = 0; }, Kind::value, "lights[2].cone_angle",
+     "must be in (0, 90]"},
+    {"spot cone_angle negative", [](json& j) { j["lights"][2]["cone_angle"] = -10; }, Kind::value,
+     "lights[2].cone_angle", "must be in (0, 90]"},
+    {"spot cone_angle tiny", [](json& j) { j["lights"][2]["cone_angle"] = 1e-60; }, Kind::value,
+     "lights[2].cone_angle", "must be in (0, 90]"},
+    {"spot cone_angle above 90", [](json& j) { j["lights"][2]["cone_angle"] = 90.5; }, Kind::value,
+     "lights[2].cone_angle", "must be in (0, 90]"},
+    {"spot cone_angle just above 90", [](json& j) { j["lights"][2]["cone_angle"] = 90.000000000001; }, Kind::value,
+     "lights[2].cone_angle", "must be in (0, 90]"},
+    {"spot cone_angle 180", [](json& j) { j["lights"][2]["cone_angle"] = 180; }, Kind::value, "lights[2].cone_angle",
+     "must be in (0, 90]"},
+    {"spot cone_angle NaN", [](json& j) { j["lights"][2]["cone_angle"] = nan; }, Kind::value, "lights[2].cone_angle",
+     "must be finite"},
+    {"spot cone_angle string", [](json& j) { j["lights"][2]["cone_angle"] = "25"; }, Kind::type,
+     "lights[2].cone_angle", "expected a number, got string"},
+    {"spot cone_angle list",
+     [](json& j) {
+         j["lights"][2]["cone_angle"] = {25};
+     },
+     Kind::type, "lights[2].cone_angle", "expected a number, got list"},
+    {"spot edge negative", [](json& j) { j["lights"][2]["edge"] = -0.01; }, Kind::value, "lights[2].edge",
+     "must be in [0, 1]"},
+    {"spot edge above 1", [](json& j) { j["lights"][2]["edge"] = 1.5; }, Kind::value, "lights[2].edge",
+     "must be in [0, 1]"},
+    {"spot edge inf", [](json& j) { j["lights"][2]["edge"] = inf; }, Kind::value, "lights[2].edge", "must be finite"},
+    {"spot edge bool", [](json& j) { j["lights"][2]["edge"] = true; }, Kind::type, "lights[2].edge",
+     "expected a number, got boolean"},
+    {"spot edge null", [](json& j) { j["lights"][2]["edge"] = nullptr; }, Kind::type, "lights[2].edge",
+     "expected a number, got null"},
+    {"spot radius 0", [](json& j) { j["lights"][2]["radius"] = 0; }, Kind::value, "lights[2].radius", "must be > 0"},
+    {"spot radius huge", [](json& j) { j["lights"][2]["radius"] = 1e4; }, Kind::value, "lights[2].radius",
+     "must be <= 1000"},
+    {"spot extra key", [](json& j) { j["lights"][2]["colour"] = 1; }, Kind::value, "lights[2].colour", "unknown key"},
+    {"spot with normal",
+     [](json& j) {
+         j["lights"][2]["normal"] = {0, 1, 0};
+     },
+     Kind::value, "lights[2].normal", "unknown key"},
+    {"spot typo cone_angle", [](json& j) { j["lights"][2]["cone_angel"] = 25; }, Kind::value, "lights[2].cone_angel",
+     "did you mean 'cone_angle'?"},
+    {"spot typo direction",
+     [](json& j) {
+         j["lights"][2]["diretion"] = {0, -1, 0};
+     },
+     Kind::value, "lights[2].diretion", "did you mean 'direction'?"},
+    {"fourth light spot",
+     [](json& j) {
+         json l = spot_light();
+         l["cone_angle"] = 120;
+         j["lights"].push_back(l);
+     },
+     Kind::value, "lights[3].cone_angle", "must be in (0, 90]"},
+    {"spot before points",
+     [](json& j) {
+         json l = spot_light();
+         l["edge"] = 2;
+         j["lights"].insert(j["lights"].begin(), l);
+     },
+     Kind::value, "lights[0].edge", "must be in [0, 1]"},
     // Surfaces.
     {"surfaces string", [](json& j) { j["surfaces"] = "x"; }, Kind::type, "surfaces", "expected a list"},
     {"surface not object", [](json& j) { j["surfaces"][1] = json::array(); }, Kind::type, "surfaces[1]",
@@ -423,6 +550,7 @@ void test_readme_example() {
     CHECK(same(s.point_lights.at(0).position, {3.0f, 5.0f, -20.0f}));
     CHECK(same(s.point_lights.at(0).intensity, {100.0f, 90.0f, 70.0f}));
     CHECK(s.point_lights.at(0).radius == 0.05f);
+    CHECK(s.spot_lights.empty());
     CHECK(s.surfaces.size() == 2);
     CHECK(s.surfaces.at(0).type == airlight::SurfaceType::plane);
     CHECK(same(s.surfaces.at(0).point, glm::vec3(0.0f)));
@@ -480,6 +608,74 @@ void test_defaults_and_accepted_forms() {
     CHECK(airlight::parse_scene_json(j).camera.position.x == 1e7f);
 }
 
+void test_spot_lights() {
+    // The base scene's spot, every key given.
+    airlight::Scene s = airlight::parse_scene_json(base_scene());
+    CHECK(s.point_lights.size() == 2 && s.spot_lights.size() == 1);
+    const airlight::SpotLight& given = s.spot_lights.at(0);
+    CHECK(same(given.position, {1.0f, 4.0f, -8.0f}));
+    CHECK(same(given.direction, {0.0f, -1.0f, 0.0f}));
+    CHECK(same(given.intensity, {500.0f, 450.0f, 400.0f}));
+    CHECK(given.cone_angle_degrees == 25.0f && given.edge == 0.15f && given.radius == 0.08f);
+
+    // Defaults: edge 0, radius 0.05; scalar intensity broadcast; direction
+    // normalised; the bounds cone_angle 90 and edge 0 and 1 accepted.
+    json j = json::parse(readme_example);
+    j["lights"] = json::array();
+    j["lights"].push_back(
+        {{"type", "spot"}, {"position", {0, 5, 0}}, {"direction", {0, -2, 0}}, {"intensity", 7}, {"cone_angle", 90}});
+    j["lights"].push_back({{"type", "point"}, {"position", {0, 1, 0}}, {"intensity", 1}});
+    j["lights"].push_back({{"type", "spot"},
+                           {"position", {1, 2, 3}},
+                           {"direction", {3, 0, -4}},
+                           {"intensity", {1, 2, 3}},
+                           {"cone_angle", 1e-3},
+                           {"edge", 1}});
+    j["lights"].push_back({{"type", "spot"},
+                           {"position", {0, 0, 0}},
+                           {"direction", {0.6, 0.8, 0}},
+                           {"intensity", 0},
+                           {"cone_angle", 45.5},
+                           {"edge", 0}});
+    s = airlight::parse_scene_json(j);
+    CHECK(s.point_lights.size() == 1 && s.spot_lights.size() == 3);
+    CHECK(same(s.point_lights.at(0).position, {0.0f, 1.0f, 0.0f}));
+    const airlight::SpotLight &a = s.spot_lights.at(0), &b = s.spot_lights.at(1), &c = s.spot_lights.at(2);
+    CHECK(same(a.position, {0.0f, 5.0f, 0.0f}));
+    CHECK(same(a.direction, {0.0f, -1.0f, 0.0f}));
+    CHECK(same(a.intensity, glm::vec3(7.0f)));
+    CHECK(a.cone_angle_degrees == 90.0f && a.edge == 0.0f && a.radius == 0.05f);
+    CHECK(std::abs(b.direction.x - 0.6f) < 1e-7f && b.direction.y == 0.0f && std::abs(b.direction.z + 0.8f) < 1e-7f);
+    CHECK(std::abs(glm::length(b.direction) - 1.0f) < 1e-6f);
+    CHECK(same(b.intensity, {1.0f, 2.0f, 3.0f}));
+    CHECK(b.cone_angle_degrees == 1e-3f && b.edge == 1.0f && b.radius == 0.05f);
+    CHECK(same(c.direction, {0.6f, 0.8f, 0.0f}));  // unit to float precision: kept as given
+    CHECK(c.cone_angle_degrees == 45.5f && c.edge == 0.0f);
+
+    // Written with every default filled in, points first, then spots.
+    json v = airlight::scene_to_json_value(s);
+    CHECK(v["lights"].size() == 4);
+    CHECK(v["lights"][0]["type"] == "point");
+    CHECK(v["lights"][1]["type"] == "spot" && v["lights"][2]["type"] == "spot" && v["lights"][3]["type"] == "spot");
+    const json& w = v["lights"][1];
+    CHECK(w.size() == 7);
+    CHECK(w["position"] == json::array({0.0, 5.0, 0.0}));
+    CHECK(w["direction"] == json::array({0.0, -1.0, 0.0}));
+    CHECK(w["intensity"] == json::array({7.0, 7.0, 7.0}));
+    CHECK(w["cone_angle"] == 90.0 && w["edge"] == 0.0 && w["radius"] == 0.05);
+    CHECK(v["lights"][2]["edge"] == 1.0 && v["lights"][2]["cone_angle"] == 0.001);
+    CHECK(!v["lights"][0].contains("direction") && !v["lights"][0].contains("cone_angle"));
+    airlight::Scene r = airlight::parse_scene_json(v);
+    CHECK(same_scene(s, r));
+    CHECK(airlight::scene_to_json_value(r) == v);
+
+    // A scene of spots only.
+    j["lights"] = json::array({spot_light()});
+    s = airlight::parse_scene_json(j);
+    CHECK(s.point_lights.empty() && s.spot_lights.size() == 1);
+    CHECK(same_scene(s, airlight::parse_scene(airlight::scene_to_json(s))));
+}
+
 void test_round_trip() {
     airlight::Scene s = airlight::parse_scene_json(base_scene());
     s.medium.sigma_t = {0.1f, 1.0f / 3.0f, 2e-7f};
@@ -494,6 +690,7 @@ void test_round_trip() {
     // Every default written; surfaces carry only their own keys.
     json v = airlight::scene_to_json_value(airlight::parse_scene(readme_example));
     CHECK(v["lights"][0]["radius"].is_number());
+    CHECK(v["lights"].size() == 1);
     CHECK(v["medium"]["albedo"].is_array() && v["medium"]["albedo"].size() == 3);
     CHECK(v["medium"]["phase"]["type"] == "isotropic");
     CHECK(v["surfaces"][1]["albedo"].is_array());
@@ -519,6 +716,14 @@ void test_round_trip() {
         j["camera"] = {{"position", vec()}, {"look_at", vec()}, {"up", vec()}, {"fov_y", 0.01 + 179.98 * unit(rng)}};
         j["medium"] = {{"sigma_t", std::pow(10.0, expo(rng))}, {"albedo", {unit(rng), unit(rng), unit(rng)}}};
         j["lights"][0]["radius"] = 1e-3 + unit(rng);
+        json spot = {{"type", "spot"},
+                     {"position", vec()},
+                     {"direction", vec()},
+                     {"intensity", {std::pow(10.0, expo(rng)), unit(rng), 0}},
+                     {"cone_angle", 90.0 * (1.0 - unit(rng))},
+                     {"edge", unit(rng)}};
+        if (i % 2) spot["radius"] = 1e-3 + unit(rng);
+        j["lights"].insert(j["lights"].begin(), spot);  // written after the point light
         j["surfaces"][0]["normal"] = vec();
         j["surfaces"].push_back({{"type", "sphere"}, {"center", vec()}, {"radius", std::pow(10.0, expo(rng))}});
         airlight::Scene a;
@@ -532,6 +737,7 @@ void test_round_trip() {
         if (!same_scene(a, b)) ++mismatches;
         float len = glm::length(a.surfaces[0].normal);
         if (std::abs(len - 1.0f) > 2e-6f) ++mismatches;
+        if (a.spot_lights.size() != 1 || std::abs(glm::length(a.spot_lights[0].direction) - 1.0f) > 2e-6f) ++mismatches;
     }
     CHECK_MSG(mismatches == 0, std::to_string(mismatches) + " mismatches");
     CHECK(rejected < 10);
@@ -569,6 +775,7 @@ int main() {
     test_text_errors();
     test_readme_example();
     test_defaults_and_accepted_forms();
+    test_spot_lights();
     test_round_trip();
     test_files();
     std::printf("%d bad-input cases, %d checks, %d failures\n", static_cast<int>(bad_cases.size()), checks, failures);

@@ -18,10 +18,12 @@ namespace airlight::shader {
 struct TableSampler {
     const Table2D* tail = nullptr;
     const Table2D* glow = nullptr;
+    FrameUniforms frame{};  // unused here (culling)
     float table_texel(int table, int x, int y) const {
         const Table2D& t = table == TABLE_AIRLIGHT_TAIL ? *tail : *glow;
         return t.texels[size_t(y) * t.width + x];
     }
+    vec4 table_texel4(int, int, int) const { return vec4(0.0f); }  // spot table: not sampled here
 #include "airlight.glsl"
 };
 }  // namespace airlight::shader

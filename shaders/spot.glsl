@@ -1,0 +1,252 @@
+// Spotlights in a homogeneous medium (MODELS.md section 2): the profile, the
+// exact ray-cone intersection and the airlight over the lit part of a view
+// ray, by the local-moment tail table (docs/spot_table.md). Requires
+// table_texel4(table, x, y) and the helpers of airlight.glsl.
+
+// I(theta) / I0 for cos theta = ct and sin^2 theta = st2, 0 outside the cone.
+// (cos theta - cos A) is computed as (sin^2 A - sin^2 theta) / (cos theta +
+// cos A), without the cancellation of the difference of two cosines.
+float spot_profile(SpotLightGpu s, float ct, float st2) {
+    float c = s.axis_cos.w;
+    if (ct < c) return 0.0f;
+    float q = s.intensity_edge.w;
+    return max((1.0f - q) * (s.cone.x - st2) / ((ct + c) * s.cone.y), 0.0f) + q;
+}
+
+// I(theta) / I0 in the emission direction `dir` (unit) from the spot.
+float spot_profile_toward(SpotLightGpu s, vec3 dir) {
+    vec3 axis = vec3(s.axis_cos);
+    vec3 across = cross(dir, axis);
+    return spot_profile(s, dot(dir, axis), dot(across, across));
+}
+
+// a * b - c * d with one rounding (Kahan's difference of products).
+float difference_of_products(float a, float b, float c, float d) {
+    float w = c * d;
+    float e = fma(-c, d, w);
+    float f = fma(a, b, -w);
+    return f + e;
+}
+
+vec3 cross_accurate(vec3 u, vec3 v) {
+    return vec3(difference_of_products(u.y, v.z, u.z, v.y), difference_of_products(u.z, v.x, u.x, v.z),
+                difference_of_products(u.x, v.y, u.y, v.x));
+}
+
+// A spot seen from a view ray, in the ray's closest-point frame: tau = x - b,
+// h the closest distance, and the axis components along d, m (towards the
+// spot from the closest point) and n = d x m.
+struct SpotRay {
+    float b;
+    float h;
+    float da;
+    float ma;
+    float na;
+};
+
+// True when tau lies in the forward nappe of the cone (the mirror nappe of
+// the quadratic is rejected here).
+bool spot_lit_at(SpotLightGpu s, SpotRay r, float tau) {
+    float ax = tau * r.da - r.h * r.ma;
+    float c = s.axis_cos.w;
+    return ax >= 0.0f && ax * ax >= c * c * (tau * tau + r.h * r.h);
+}
+
+// The lit part [lo, hi] (in tau) of the ray segment [tau_start, tau_end]
+// (tau_end may be NO_HIT): exact ray-cone intersection in the sin^2 A form of
+// docs/spot_table.md section 4. The forward nappe is convex, so the lit part
+// is one interval; returns false when it is empty. wall_lo / wall_hi tell
+// whether an end lies on the cone wall (else it is a clipping end).
+bool spot_lit_interval(SpotLightGpu s, SpotRay r, float tau_start, float tau_end, OUT(float) lo, OUT(float) hi,
+                       OUT(bool) wall_lo, OUT(bool) wall_hi) {
+    float c = s.axis_cos.w;
+    float s2 = s.cone.x;
+    float A = s2 - r.ma * r.ma - r.na * r.na;  // (d.a)^2 - cos^2 A
+    float C0 = r.h * r.h * (s2 - r.da * r.da - r.na * r.na);
+    float rad = s2 - r.na * r.na;
+    // Break points: the segment's ends and the finite roots inside it, sorted.
+    float p0 = tau_start;
+    float p1 = NO_HIT;
+    float p2 = NO_HIT;
+    if (rad >= 0.0f) {
+        float hb = r.h * r.da * r.ma;
+        float qq = hb + (hb >= 0.0f ? 1.0f : -1.0f) * c * r.h * sqrt(rad);
+        float r1 = qq / A;
+        float r2 = C0 / qq;
+        bool ok1 = abs(r1) < NO_HIT && r1 > tau_start && r1 < tau_end;  // false for inf and NaN
+        bool ok2 = abs(r2) < NO_HIT && r2 > tau_start && r2 < tau_end;
+        if (ok1 && ok2) {
+            p1 = min(r1, r2);
+            p2 = max(r1, r2);
+        } else if (ok1) {
+            p1 = r1;
+        } else if (ok2) {
+            p1 = r2;
+        }
+    }
+    // Sub-intervals [p0, p1], [p1, p2], [p2, end] (those that exist); the lit
+    // ones are contiguous.
+    bool found = false;
+    lo = 0.0f;
+    hi = 0.0f;
+    wall_lo = false;
+    wall_hi = false;
+    for (int k = 0; k < 3; ++k) {
+        float a = k == 0 ? p0 : (k == 1 ? p1 : p2);
+        float e = k == 0 ? (p1 < NO_HIT ? p1 : tau_end) : (k == 1 ? (p2 < NO_HIT ? p2 : tau_end) : tau_end);
+        if (a >= NO_HIT || !(e > a)) continue;
+        float mid = e >= NO_HIT ? a + max(r.h, abs(a)) : 0.5f * (a + e);
+        if (!spot_lit_at(s, r, mid)) continue;
+        if (!found) {
+            lo = a;
+            wall_lo = k > 0;
+            found = true;
+        }
+        hi = e;
+        wall_hi = e < tau_end;
+    }
+    return found;
+}
+
+// The spot tail at tau, per unit I0 and in units of sigma_s I0 / (2 pi h)
+// exp(-sigma (x + d)): Q (I_v - 2 beta cos(theta_v) M2 + beta g_v M1), and the
+// sum of the magnitudes of its terms (for the cancellation test).
+float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, OUT(float) magnitude,
+                OUT(float) ct, OUT(float) g, OUT(float) profile) {
+    float h = r.h;
+    float dd = sqrt(h * h + tau * tau);
+    float p = tau >= 0.0f ? dd + tau : h * h / (dd - tau);  // d + x - b
+    float t = p / h;
+    float cv = 0.5f * atan(h, tau);
+    float z = min(sigma * sqrt(2.0f * dd * p), 1.0e20f);
+    float lam = 2.0f * sigma * dd * t;
+    vec4 T = table_bilinear4(TABLE_SPOT_MOMENTS, AIRLIGHT_TAIL_NX, AIRLIGHT_TAIL_NY, sqrt(z / (1.0f + z)),
+                             1.0f - cv * (2.0f / PI));
+    float N = cv / (1.0f + lam * cv);
+    float N1 = cv / (1.0f + 0.5f * lam * cv);
+    float Q = N * T.x;
+    float M1 = N1 * T.y;
+    float M2 = 0.5f * N1 * N1 * T.z;
+    ct = (tau * r.da - h * r.ma) / dd;
+    g = (h * r.da + tau * r.ma) / dd;
+    float q = s.intensity_edge.w;
+    profile = wall ? q : max((1.0f - q) * (s.cone.x - r.na * r.na - g * g) / ((ct + s.axis_cos.w) * s.cone.y), 0.0f) + q;
+    float beta = s.cone.z;
+    magnitude = Q * (abs(profile) + 2.0f * beta * abs(ct) * M2 + beta * abs(g) * M1);
+    return Q * (profile - 2.0f * beta * ct * M2 + beta * g * M1);
+}
+
+// Airlight of a spot over its lit interval [lo, hi] of the view ray, one
+// channel: scale exp(-sigma (x_lo + d_lo)) J (docs/spot_table.md section 3),
+// scale = sigma_s I0 / (2 pi h) > 0 folded into the exponent. J is the
+// difference of two spot tails, or, where that difference would amplify the
+// table error more than 4 times, 4-point Gauss-Legendre in xi on the exact
+// integrand written about lo.
+float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, bool wall_lo, bool wall_hi,
+                            float clip_length, float scale) {
+    float mag0;
+    float ct0;
+    float g0;
+    float profile0;
+    float tail0 = spot_tail(s, r, sigma, lo, wall_lo, mag0, ct0, g0, profile0);
+    float arg0 = -sigma * (r.b + lo + sqrt(r.h * r.h + lo * lo));
+    bool escapes = hi >= NO_HIT;
+    float J = tail0;
+    float mag = mag0;
+    if (!escapes) {
+        float mag1;
+        float ct1;
+        float g1;
+        float profile1;
+        float tail1 = spot_tail(s, r, sigma, hi, wall_hi, mag1, ct1, g1, profile1);
+        float arg1 = -sigma * (r.b + hi + sqrt(r.h * r.h + hi * hi));
+        float ratio = exp(arg1 - arg0);
+        J = tail0 - ratio * tail1;
+        mag = mag0 + ratio * mag1;
+    }
+    if (!(mag <= 4.0f * abs(J))) {
+        float h = r.h;
+        float cv0 = 0.5f * atan(h, lo);
+        float length_lit = (wall_lo || wall_hi) ? hi - lo : clip_length;
+        float dv = escapes ? cv0 : 0.5f * atan(h * length_lit, h * h + lo * hi);
+        float u = sigma * h;
+        float s0 = sin(cv0);
+        float beta = s.cone.z;
+        J = 0.0f;
+        for (int k = 0; k < 4; ++k) {
+            float node = k == 0 ? -0.8611363115940526f
+                                : (k == 1 ? -0.3399810435848563f : (k == 2 ? 0.3399810435848563f : 0.8611363115940526f));
+            float weight = (k == 0 || k == 3) ? 0.3478548451374538f : 0.6521451548625461f;
+            float D = dv * 0.5f * (1.0f + node);
+            float sD = sin(D);
+            float I = max(profile0 - 2.0f * beta * ct0 * sD * sD + beta * g0 * sin(2.0f * D), 0.0f);
+            float w = D < cv0 ? exp(-u * sD / (s0 * sin(cv0 - D))) : 0.0f;
+            J += 0.5f * weight * I * w;
+        }
+        J *= dv;
+    }
+    return max(J, 0.0f) * exp(arg0 + log(scale));
+}
+
+// Brute-force airlight of a spot on [x0, x1] (benchmarks): the midpoint rule on
+// the defining integral with the profile evaluated at each step.
+vec3 spot_airlight_march(SpotLightGpu s, vec3 origin, vec3 dir, float x0, float x1) {
+    vec3 position = vec3(s.world_position);
+    float x_end = min(x1, frame.quality.z);
+    int steps = int(frame.quality.y);
+    float dx = (x_end - x0) / float(steps);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 sum = vec3(0.0f);
+    for (int k = 0; k < steps; ++k) {
+        float x = x0 + (float(k) + 0.5f) * dx;
+        vec3 from_light = origin + x * dir - position;
+        float d2 = dot(from_light, from_light);
+        float d = sqrt(d2);
+        sum += spot_profile_toward(s, from_light / d) * exp(-sigma_t * (x + d)) / d2;
+    }
+    return vec3(frame.sigma_s) * vec3(s.intensity_edge) * sum * (dx / (4.0f * PI));
+}
+
+// Airlight of spot `s` over the visible part [0, x_end] of the view ray from
+// the camera (MODELS.md section 2): only the lit part of the ray scatters. A
+// camera inside the lamp's sphere sees fog from where the ray leaves it.
+// Skipped when the point-light bound (the profile is <= 1) is negligible
+// against `so_far`.
+vec3 spot_light_airlight(SpotLightGpu s, vec3 dir, float x_end, vec3 so_far) {
+    vec3 Sr = vec3(s.relative_position_radius);
+    float radius = s.relative_position_radius.w;
+    float dist = length(Sr);
+    SpotRay r;
+    r.b = dot(Sr, dir);
+    vec3 c1 = cross_accurate(Sr, dir);
+    r.h = max(length(c1), 1.0e-6f * max(dist, radius));
+    vec3 hm = cross(dir, c1);
+    vec3 axis = vec3(s.axis_cos);
+    r.da = dot(dir, axis);
+    r.ma = dot(hm, axis) / r.h;
+    r.na = -dot(c1, axis) / r.h;
+    float x0 = 0.0f;
+    if (dist < radius) x0 = r.b + sqrt(max(radius * radius - r.h * r.h, 0.0f));
+    if (x0 >= x_end) return vec3(0.0f);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 scale = vec3(frame.sigma_s) * vec3(s.intensity_edge) / (2.0f * PI * r.h);
+    float min_sigma_t = min(min(sigma_t.x, sigma_t.y), sigma_t.z);
+    if (negligible(scale * ((0.5f * PI) * exp(-min_sigma_t * max(dist - radius, 0.0f))), so_far)) return vec3(0.0f);
+    float lo;
+    float hi;
+    bool wall_lo;
+    bool wall_hi;
+    float tau_end = x_end >= NO_HIT ? NO_HIT : x_end - r.b;
+    if (!spot_lit_interval(s, r, x0 - r.b, tau_end, lo, hi, wall_lo, wall_hi)) return vec3(0.0f);
+    if (AIRLIGHT_MARCH) return spot_airlight_march(s, vec3(frame.camera_position), dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
+    float clip_length = x_end - x0;
+    if (GREY_MEDIUM) {
+        float peak = max(max(scale.x, scale.y), scale.z);
+        if (!(peak > 0.0f)) return vec3(0.0f);
+        return (scale / peak) * spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, peak);
+    }
+    return vec3(
+        scale.x > 0.0f ? spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, scale.x) : 0.0f,
+        scale.y > 0.0f ? spot_airlight_channel(s, r, sigma_t.y, lo, hi, wall_lo, wall_hi, clip_length, scale.y) : 0.0f,
+        scale.z > 0.0f ? spot_airlight_channel(s, r, sigma_t.z, lo, hi, wall_lo, wall_hi, clip_length, scale.z) : 0.0f);
+}
