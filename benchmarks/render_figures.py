@@ -1,0 +1,44 @@
+"""Renders the preset scenes shown in the README into docs/images.
+
+    .venv/bin/python benchmarks/render_figures.py [--backend auto]
+
+- foggy_street.png: 16 street lamps in fog (exposure 0.1);
+- spotlights_crossing.png: the source paper's figure 8, two spotlights
+  crossing in media of density 0, 0.01, 0.02 and 0.04 per metre (2 x 2);
+- crane_searchlight.png: a crane's searchlight over the foggy street.
+"""
+
+from __future__ import annotations
+
+import argparse
+from pathlib import Path
+
+import numpy as np
+from PIL import Image
+
+import airlight
+
+IMAGES = Path(__file__).resolve().parents[1] / "docs" / "images"
+
+
+def main() -> None:
+    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    ap.add_argument("--backend", default="auto")
+    args = ap.parse_args()
+    IMAGES.mkdir(parents=True, exist_ok=True)
+    with airlight.Renderer(args.backend) as r:
+        street = r.render(airlight.preset("foggy_street"))
+        airlight.save_png(IMAGES / "foggy_street.png", street, exposure=0.1)
+        tiles = []
+        for density in ("000", "001", "002", "004"):
+            radiance = r.render(airlight.preset(f"spotlights_crossing_{density}"), width=320, height=180)
+            tiles.append(airlight.to_srgb8(radiance, 2.0))
+        grid = np.concatenate([np.concatenate(tiles[:2], axis=1), np.concatenate(tiles[2:], axis=1)], axis=0)
+        Image.fromarray(grid).save(IMAGES / "spotlights_crossing.png")
+        crane = r.render(airlight.preset("crane_searchlight"))
+        airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
+    print(f"wrote {IMAGES}/foggy_street.png, spotlights_crossing.png, crane_searchlight.png")
+
+
+if __name__ == "__main__":
+    main()
