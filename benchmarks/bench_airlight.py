@@ -42,13 +42,19 @@ SIGMA_T = 0.04
 ALBEDO = 0.9
 
 
-def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.0) -> dict:
-    """A straight street along -z: lamps 6 m high every 15 m, alternating sides."""
+def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.0,
+                 light_type: str = "point") -> dict:
+    """A straight street along -z: lamps 6 m high every 15 m, alternating sides;
+    with light_type "spot", each lamp is a 35-degree spot aimed down and across the road."""
     lights = []
     for i in range(lamps):
         side = -1 if i % 2 == 0 else 1
-        lights.append({"type": "point", "position": [side * 5.0, 6.0, -8.0 - 7.5 * i],
-                       "intensity": [900.0, 700.0, 450.0], "radius": 0.15})
+        light = {"type": "point", "position": [side * 5.0, 6.0, -8.0 - 7.5 * i],
+                 "intensity": [900.0, 700.0, 450.0], "radius": 0.15}
+        if light_type == "spot":
+            light.update(type="spot", direction=[-side * 0.5, -1.0, -0.2], cone_angle=35.0, edge=0.1,
+                         intensity=[4000.0, 3200.0, 2200.0])
+        lights.append(light)
     surfaces = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": surface_albedo}]
     for k in range(12):
         z0 = -20.0 - 45.0 * k
@@ -125,16 +131,33 @@ def reference_airlight(scene: dict, origin: np.ndarray, d: np.ndarray, t_end: fl
         s = np.array(light["position"], float)
         b = (s - origin) @ d
         h2 = max(float((s - origin) @ (s - origin)) - b * b, 0.0)
+        spot = light["type"] == "spot"
+        axis = np.array(light.get("direction", [0.0, -1.0, 0.0]), float)
+        axis /= np.linalg.norm(axis)
+        cos_a = math.cos(math.radians(light.get("cone_angle", 90.0)))
+        q = light.get("edge", 0.0)
 
-        def f(x: float, b: float = b, h2: float = h2) -> float:
+        def f(x: float, b: float = b, h2: float = h2, s: np.ndarray = s, spot: bool = spot,
+              axis: np.ndarray = axis, cos_a: float = cos_a, q: float = q) -> float:
             r2 = h2 + (x - b) ** 2
-            return math.exp(-SIGMA_T * (x + math.sqrt(r2))) / r2
+            value = math.exp(-SIGMA_T * (x + math.sqrt(r2))) / r2
+            if spot:  # MODELS.md section 2 profile, zero outside the cone
+                ct = ((origin + x * d - s) @ axis) / math.sqrt(r2)
+                value *= 0.0 if ct < cos_a else (1 - q) * (ct - cos_a) / (1 - cos_a) + q
+            return value
 
-        pieces = [0.0]
-        if 0 < b < t_end:
-            pieces.append(b)
         far = t_end if math.isfinite(t_end) else max(b, 0.0) + 60.0 / SIGMA_T
-        pieces.append(far)
+        pieces = [0.0, far]
+        if 0 < b < far:
+            pieces.append(b)
+        if spot:  # the cone wall crossings (textbook quadratic in double) as break points
+            w = origin - s
+            qa = (d @ axis) ** 2 - cos_a**2
+            qb = 2 * ((d @ axis) * (w @ axis) - cos_a**2 * (d @ w))
+            qc = (w @ axis) ** 2 - cos_a**2 * (w @ w)
+            roots = np.roots([qa, qb, qc]) if abs(qa) > 1e-15 else np.array([-qc / qb])
+            pieces += [float(r.real) for r in roots if abs(r.imag) < 1e-9 and 0 < r.real < far]
+        pieces = sorted(pieces)
         value = sum(quad(f, a, c, epsabs=0, epsrel=1e-10, limit=400)[0] for a, c in zip(pieces, pieces[1:]))
         total += sigma_s / (4 * math.pi) * np.array(light["intensity"], float) * value
     return total
@@ -229,6 +252,8 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=360)
     ap.add_argument("--samples", type=int, default=300)
     ap.add_argument("--backends", nargs="+", default=airlight.available_backends())
+    ap.add_argument("--light-type", choices=("point", "spot"), default="point",
+                    help="street lamps as point lights (MODELS.md section 1) or as spots (section 2)")
     default_plot = Path(__file__).resolve().parents[1] / "docs/images/bench_airlight.png"
     ap.add_argument("--plot", default=str(default_plot))
     args = ap.parse_args()
@@ -236,14 +261,15 @@ def main() -> None:
     renderers = {b: airlight.Renderer(b) for b in args.backends}
     results: dict[tuple[str, int], dict] = {}
 
-    print(f"street at {args.width}x{args.height}, sigma_t {SIGMA_T}/m, albedo {ALBEDO}; "
+    print(f"street of {args.light_type} lights at {args.width}x{args.height}, sigma_t {SIGMA_T}/m, "
+          f"albedo {ALBEDO}; "
           f"error = max relative error over {args.samples} sampled pixels, half of them "
           "in the lamps' halos (cores excluded)")
     base = {b: timed(r, street_scene(0, args.width, args.height))[0] for b, r in renderers.items()}
     print("frame with no lamps (tracing only): " + ", ".join(f"{b} {1e3 * t:.1f} ms"
                                                              for b, t in base.items()))
     for lamps in args.lamps:
-        scene = street_scene(lamps, args.width, args.height)
+        scene = street_scene(lamps, args.width, args.height, light_type=args.light_type)
         pixels = sample_pixels(scene, args.samples, rng)
         t0 = time.perf_counter()
         ref, core = reference_for(scene, pixels)

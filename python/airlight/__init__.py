@@ -17,9 +17,11 @@ from __future__ import annotations
 
 import copy
 import json
+import math
+import numbers
 import os
 import warnings
-from collections.abc import Mapping
+from collections.abc import Mapping, Sequence
 from pathlib import Path
 from typing import Any, Union
 
@@ -34,6 +36,7 @@ __all__ = [
     "SceneLike",
     "available_backends",
     "gl_unavailable_reason",
+    "headlights",
     "load_pfm",
     "load_scene",
     "preset",
@@ -205,6 +208,112 @@ def table_stats() -> dict[str, dict[str, Any]]:
     first need): name -> width, height, bytes, build_seconds. Empty until a scene
     with lamps in a scattering medium is rendered."""
     return dict(_core.tables_built())
+
+
+def _real(name: str, value: Any) -> float:
+    """``value`` as a finite float; TypeError/ValueError naming ``name`` otherwise."""
+    if isinstance(value, bool) or not isinstance(value, numbers.Real):
+        raise TypeError(f"{name}: expected a number, got {type(value).__name__}")
+    x = float(value)
+    if not math.isfinite(x):
+        raise ValueError(f"{name}: must be finite, got {value!r}")
+    return x
+
+
+def _vec3(name: str, value: Any) -> list[float]:
+    if isinstance(value, np.ndarray) and value.ndim == 1:
+        value = value.tolist()
+    if isinstance(value, (str, bytes)) or not isinstance(value, Sequence):
+        raise TypeError(f"{name}: expected a list of 3 numbers, got {type(value).__name__}")
+    if len(value) != 3:
+        raise ValueError(f"{name}: expected a list of exactly 3 numbers, got {len(value)}")
+    return [_real(f"{name}[{i}]", v) for i, v in enumerate(value)]
+
+
+def _rgb(name: str, value: Any) -> list[float]:
+    """An RGB value (a number or 3 numbers), each channel finite and >= 0."""
+    if isinstance(value, numbers.Real) and not isinstance(value, bool):
+        rgb = [_real(name, value)] * 3
+    else:
+        rgb = _vec3(name, value)
+    if any(c < 0 for c in rgb):
+        raise ValueError(f"{name}: must be >= 0, got {value!r}")
+    return rgb
+
+
+def _sin_cos_degrees(angle: float) -> tuple[float, float]:
+    """(sin, cos) of an angle in degrees, exact at multiples of 90."""
+    quarter, rest = divmod(angle, 90.0)
+    if rest == 0:
+        return ((0.0, 1.0), (1.0, 0.0), (0.0, -1.0), (-1.0, 0.0))[int(quarter) % 4]
+    a = math.radians(angle)
+    return math.sin(a), math.cos(a)
+
+
+def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.4, height: float = 0.65,
+               intensity: float | Sequence[float] = (20000.0, 19000.0, 17000.0), cone_angle: float = 25.0,
+               edge: float = 0.15, pitch: float = -2.0, lens_lamps: bool = False,
+               lens_intensity: float | Sequence[float] = 50.0, radius: float = 0.05) -> list[dict[str, Any]]:
+    """A car's two headlights as light dicts for a scene's ``"lights"`` list.
+
+    ``position`` is the car's front centre on the ground ``[x, y, z]`` (y is
+    usually 0); ``heading`` the direction of travel in degrees, measured like
+    the sun's azimuth: 0 is -z, 90 is +x, i.e. the direction
+    ``(sin h, 0, -cos h)``. The two spot lights sit ``spacing`` metres apart,
+    ``spacing / 2`` either side of the heading, ``height`` metres above
+    ``position``, and shine along the heading tilted by ``pitch`` degrees
+    (negative: down), with on-axis intensity ``intensity`` (W/sr, RGB),
+    half-angle ``cone_angle`` (degrees, in (0, 90]) and edge softness ``edge``
+    (in [0, 1]); see the README's scene format. ``radius`` is each lamp's
+    emitting sphere. With ``lens_lamps=True`` two small point lamps of
+    intensity ``lens_intensity`` and the same radius are added at the same
+    places, so that the lenses are seen glowing from any direction.
+
+    Returns ``[left spot, right spot]`` (left and right as seen from the
+    driver's seat), followed by ``[left lamp, right lamp]`` with
+    ``lens_lamps``. Bad arguments raise ``TypeError``/``ValueError`` whose
+    message starts with the argument's name.
+    """
+    origin = _vec3("position", position)
+    sin_h, cos_h = _sin_cos_degrees(_real("heading", heading))
+    spacing = _real("spacing", spacing)
+    if spacing <= 0:
+        raise ValueError(f"spacing: must be > 0, got {spacing!r}")
+    height = _real("height", height)
+    if height < 0:
+        raise ValueError(f"height: must be >= 0, got {height!r}")
+    rgb = _rgb("intensity", intensity)
+    cone_angle = _real("cone_angle", cone_angle)
+    if not 0 < cone_angle <= 90:
+        raise ValueError(f"cone_angle: must be in (0, 90], got {cone_angle!r}")
+    edge = _real("edge", edge)
+    if not 0 <= edge <= 1:
+        raise ValueError(f"edge: must be in [0, 1], got {edge!r}")
+    pitch = _real("pitch", pitch)
+    if not -90 <= pitch <= 90:
+        raise ValueError(f"pitch: must be in [-90, 90], got {pitch!r}")
+    if not isinstance(lens_lamps, bool):
+        raise TypeError(f"lens_lamps: expected a bool, got {type(lens_lamps).__name__}")
+    lens_rgb = _rgb("lens_intensity", lens_intensity)
+    radius = _real("radius", radius)
+    if not 0 < radius <= 1000:
+        raise ValueError(f"radius: must be in (0, 1000], got {radius!r}")
+
+    sin_p, cos_p = _sin_cos_degrees(pitch)
+    forward = (sin_h, 0.0, -cos_h)
+    right = (cos_h, 0.0, sin_h)  # forward x up
+    direction = [cos_p * forward[0] + 0.0, sin_p + 0.0, cos_p * forward[2] + 0.0]  # + 0.0: no -0.0
+    places = [[origin[0] + side * 0.5 * spacing * right[0] + 0.0, origin[1] + height + 0.0,
+               origin[2] + side * 0.5 * spacing * right[2] + 0.0] for side in (-1.0, 1.0)]
+    lights: list[dict[str, Any]] = [
+        {"type": "spot", "position": list(at), "direction": list(direction), "intensity": list(rgb),
+         "cone_angle": cone_angle, "edge": edge, "radius": radius}
+        for at in places
+    ]
+    if lens_lamps:
+        lights += [{"type": "point", "position": list(at), "intensity": list(lens_rgb), "radius": radius}
+                   for at in places]
+    return lights
 
 
 def preset_names() -> list[str]:

@@ -78,7 +78,7 @@ def test_demo_auto_backend_renders(tmp_path: Path, scene_file: Path) -> None:
     (lambda s: s["medium"].update(sigma_t=-1), "medium.sigma_t"),
     (lambda s: s["surfaces"][1].update(max=[-4, 0, -12]), "surfaces[1].max"),
     (lambda s: s.update(camra=s.pop("camera")), "camra"),
-    (lambda s: s["lights"][0].update(type="spot"), "lights[0].type"),
+    (lambda s: s["lights"][0].update(type="area"), "lights[0].type"),
     (lambda s: s["film"].update(width="wide"), "film.width"),
 ])
 def test_demo_bad_scene_exits_nonzero_with_one_line_naming_the_field(

@@ -125,7 +125,7 @@ BAD_SCENES = [
     ("fov_y_negative", _set("camera.fov_y", -5), ValueError, "camera.fov_y"),
     ("fov_y_nan", _set("camera.fov_y", NAN), ValueError, "camera.fov_y"),
     ("zero_plane_normal", _set("surfaces[0].normal", [0, 0, 0]), ValueError, "surfaces[0].normal"),
-    ("unknown_light_type", _set("lights[0].type", "spot"), ValueError, "lights[0].type"),
+    ("unknown_light_type", _set("lights[0].type", "area"), ValueError, "lights[0].type"),
     ("unknown_surface_type", _set("surfaces[1].type", "cylinder"), ValueError, "surfaces[1].type"),
     ("unknown_phase_type", _set("medium.phase.type", "rayleigh"), ValueError, "medium.phase.type"),
     ("box_min_equals_max", _set("surfaces[1].max", [-8.0, 12.0, -25.0]), ValueError, "surfaces[1].max"),
