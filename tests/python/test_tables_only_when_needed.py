@@ -60,6 +60,18 @@ def test_lamps_in_fog_build_each_table_once():
     assert stats["surface_glow"]["bytes"] == 256 * 128 * 4
 
 
+SPOT = [{"type": "spot", "position": [0, 6, -10], "direction": [0, -1, 0], "intensity": 500, "cone_angle": 30}]
+
+
+def test_spot_moment_table_only_for_spots_in_fog():
+    """Point lamps in fog build no spot table; spots in fog build it; spots in clear air nothing."""
+    assert run([base(lights=LAMP, medium=FOG)])["seen"] == [["airlight_tail", "surface_glow"]]
+    assert run([base(lights=SPOT, medium=FOG)])["seen"] == [["airlight_tail", "spot_moments"]]
+    assert run([base(lights=SPOT)])["seen"] == [[]]
+    stats = run([base(lights=SPOT, medium=FOG)])["stats"]
+    assert stats["spot_moments"]["bytes"] == 256 * 64 * 4 * 4
+
+
 def test_ray_marched_airlight_builds_no_tail_table():
     scene = base(lights=LAMP, medium=FOG, quality={"airlight": "march", "march_steps": 16})
     assert run([scene])["seen"] == [["surface_glow"]]
