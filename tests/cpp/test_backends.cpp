@@ -3,6 +3,7 @@
 // the image conventions (row 0 on top, lamp core radiance) hold on both.
 #include <algorithm>
 #include <cmath>
+#include <glm/geometric.hpp>
 #include <string>
 
 #include "airlight/renderer.hpp"
@@ -84,14 +85,23 @@ int test_gl_matches_cpu() {
     Renderer cpu(Backend::cpu);
     Renderer gl(Backend::gl);
     // Every feature combination (shader variant) compiles and agrees:
-    // medium, lights, surfaces, grey medium, ray-marched airlight.
-    for (int mask = 0; mask < 32; ++mask) {
+    // medium, lights, surfaces, grey medium, ray-marched airlight, spotlights.
+    for (int mask = 0; mask < 64; ++mask) {
         Scene scene = base_scene();
         if (!(mask & 1)) scene.has_medium = false;
         if (!(mask & 2)) scene.point_lights.clear();
         if (!(mask & 4)) scene.surfaces.clear();
         if (mask & 8) scene.medium.sigma_t = glm::vec3(0.05f);
         if (mask & 16) scene.quality.airlight = AirlightMethod::march;
+        if (mask & 32) {
+            SpotLight spot;
+            spot.position = glm::vec3(-2.0f, 5.0f, -12.0f);
+            spot.direction = glm::normalize(glm::vec3(0.3f, -1.0f, -0.2f));
+            spot.intensity = glm::vec3(400.0f, 350.0f, 300.0f);
+            spot.cone_angle_degrees = 25.0f;
+            spot.edge = 0.2f;
+            scene.spot_lights.push_back(spot);
+        }
         const Image a = cpu.render(scene);
         const Image b = gl.render(scene);
         CHECK(all_finite_nonnegative(b));
