@@ -219,12 +219,23 @@ vec3 spot_light_airlight(SpotLightGpu s, vec3 dir, float x_end, vec3 so_far) {
     SpotRay r;
     r.b = dot(Sr, dir);
     vec3 c1 = cross_accurate(Sr, dir);
-    r.h = max(length(c1), 1.0e-6f * max(dist, radius));
-    vec3 hm = cross(dir, c1);
+    float closest = length(c1);
+    // The frame (d, m, n): m = d x c1 / |c1| points from the closest ray point
+    // to the spot, n = -c1 / |c1|. A ray through the spot's centre (c1 = 0)
+    // takes any unit m across the ray; h is only floored for the 1/h scale.
     vec3 axis = vec3(s.axis_cos);
+    vec3 m;
+    if (closest > 0.0f) {
+        m = cross(dir, c1) / closest;
+    } else {
+        vec3 across = cross(dir, abs(dir.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f));
+        m = normalize(across);
+    }
+    vec3 n = cross(dir, m);
+    r.h = max(closest, 1.0e-6f * max(dist, radius));
     r.da = dot(dir, axis);
-    r.ma = dot(hm, axis) / r.h;
-    r.na = -dot(c1, axis) / r.h;
+    r.ma = dot(m, axis);
+    r.na = dot(n, axis);
     float x0 = 0.0f;
     if (dist < radius) x0 = r.b + sqrt(max(radius * radius - r.h * r.h, 0.0f));
     if (x0 >= x_end) return vec3(0.0f);

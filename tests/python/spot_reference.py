@@ -133,7 +133,8 @@ def parse_spot_scene(scene: Any) -> SpotScene:
         if kind == "point":
             spots.append(None)
         elif kind == "spot":
-            spots.append(make_spot(li["direction"], float(li["cone_angle"]), float(li.get("edge", DEFAULT_EDGE))))
+            edge = float(li.get("edge", DEFAULT_EDGE))
+            spots.append(make_spot(li["direction"], float(li["cone_angle"]), edge))
         else:
             raise ValueError(f"spot_reference: unknown light type {kind!r}")
     # airlight_reference.parse_scene reads position, intensity and radius of any light
@@ -191,7 +192,7 @@ def ray_frame(origin: np.ndarray, dirs: np.ndarray, position: np.ndarray, axis: 
     return RayFrame(b, h, m, dirs @ axis, m @ axis, -(rel @ axis))
 
 
-def _bisect(pred, lo: np.ndarray, hi: np.ndarray, iterations: int = 110) -> np.ndarray:
+def _bisect(pred, lo: np.ndarray, hi: np.ndarray, iterations: int = 80) -> np.ndarray:
     """Vectorised bisection: pred(s) is True on [lo, boundary) and False on (boundary, hi];
     returns the boundary to within rounding."""
     lo, hi = lo.copy(), hi.copy()
@@ -226,6 +227,12 @@ def lit_interval(origin: np.ndarray, dirs: np.ndarray, position: np.ndarray, spo
         dist = np.hypot(fr.h, x - fr.b)
         return fr.da - c * np.where(dist > 0, (x - fr.b) / np.where(dist > 0, dist, 1.0), 0.0)
 
+    with np.errstate(invalid="ignore", over="ignore"):  # g and g' at x = inf, where masked out
+        return _lit_interval_search(x0, x1, scale, c, fr, x_of, g, gp)
+
+
+def _lit_interval_search(x0, x1, scale, c, fr, x_of, g, gp):
+    n = len(x0)
     finite = np.isfinite(x1)
     span = np.where(finite, x1 - x0, 1.0)
     s1 = np.where(finite, span / (scale + span), 1.0)
@@ -321,6 +328,22 @@ def _spot_unit_log_cached(*args: float) -> float:
     return _spot_unit_log(*args)
 
 
+def spot_unit_logs(sigma_t: float, origin: Sequence[float], dirs: np.ndarray, position: Sequence[float],
+                   spot: Spot, x0: Any = 0.0, x1: Any = math.inf) -> np.ndarray:
+    """Per ray (N,): log of int (I / I0) exp(-sigma_t (x + |S - p|)) / |S - p|^2 dx over the
+    lit part of [x0, x1] (-inf when none); the lit intervals are found for all rays at once."""
+    dirs = np.atleast_2d(np.asarray(dirs, dtype=np.float64))
+    origin = np.asarray(origin, dtype=np.float64)
+    position = np.asarray(position, dtype=np.float64)
+    lo, hi, meets = lit_interval(origin, dirs, position, spot, x0, x1)
+    fr = ray_frame(origin, dirs, position, spot.axis)
+    out = np.full(len(dirs), -math.inf)
+    for k in np.nonzero(meets)[0]:
+        out[k] = _spot_unit_log_cached(float(sigma_t), float(fr.b[k]), float(fr.h[k]), float(fr.da[k]),
+                                       float(fr.ma[k]), spot.cos_a, spot.edge, float(lo[k]), float(hi[k]))
+    return out
+
+
 def spot_airlight_log(sigma_t: float, sigma_s: float, intensity: float, origin: Sequence[float],
                       direction: Sequence[float], position: Sequence[float], spot: Spot, x0: float = 0.0,
                       x1: float = math.inf) -> float:
@@ -328,15 +351,8 @@ def spot_airlight_log(sigma_t: float, sigma_s: float, intensity: float, origin: 
     `intensity`) over [x0, x1] of the ray origin + x direction (unit); -inf when 0."""
     if sigma_s <= 0 or intensity <= 0 or not x1 > x0:
         return -math.inf
-    origin = np.asarray(origin, dtype=np.float64)
-    direction = np.asarray(direction, dtype=np.float64)
-    position = np.asarray(position, dtype=np.float64)
-    lo, hi, meets = lit_interval(origin, direction[None, :], position, spot, x0, x1)
-    if not meets[0]:
-        return -math.inf
-    fr = ray_frame(origin, direction[None, :], position, spot.axis)
-    unit = _spot_unit_log_cached(float(sigma_t), float(fr.b[0]), float(fr.h[0]), float(fr.da[0]),
-                                 float(fr.ma[0]), spot.cos_a, spot.edge, float(lo[0]), float(hi[0]))
+    dirs = np.asarray(direction, dtype=np.float64)[None, :]
+    unit = spot_unit_logs(sigma_t, origin, dirs, position, spot, x0, x1)[0]
     return math.log(sigma_s * intensity / (4.0 * math.pi)) + unit
 
 
@@ -386,8 +402,10 @@ def spot_direct(ss: SpotScene, point: np.ndarray, normal: np.ndarray, albedo: np
         light, spot = ss.sc.lights[j], ss.spots[j]
         to_light = light.position - point
         dist = float(np.linalg.norm(to_light))
+        if not lit[j] or dist <= 0.0:
+            continue
         cos_s = float(to_light @ normal) / dist
-        if not lit[j] or cos_s <= 0:
+        if cos_s <= 0:
             continue
         weight = float(direction_profile(spot, light.position, point))
         out += light.intensity * weight * cos_s / max(dist * dist, light.radius ** 2) * np.exp(
@@ -395,16 +413,22 @@ def spot_direct(ss: SpotScene, point: np.ndarray, normal: np.ndarray, albedo: np
     return albedo / math.pi * out
 
 
-def ray_spot_airlight(ss: SpotScene, origin: np.ndarray, direction: np.ndarray, t_hit: float) -> np.ndarray:
-    """Airlight (3,) of all spots over the visible part [x0, t_hit] of a ray."""
+def rays_spot_airlight(ss: SpotScene, dirs: np.ndarray, t_hit: np.ndarray) -> np.ndarray:
+    """Airlight (N, 3) of all spots over the visible parts [x0, t_hit] of camera rays."""
     sc = ss.sc
-    total = np.zeros(3)
+    total = np.zeros((len(dirs), 3))
     for j in ss.spot_indices:
         light, spot = sc.lights[j], ss.spots[j]
-        _, _, x0 = ray_light_geometry(origin, direction, light)
+        x0 = np.array([ray_light_geometry(sc.position, d, light)[2] for d in dirs])
+        units: dict[float, np.ndarray] = {}
         for c in range(3):
-            total[c] += spot_airlight(sc.sigma_t[c], sc.sigma_s[c], light.intensity[c], origin, direction,
-                                      light.position, spot, x0, t_hit)
+            if sc.sigma_s[c] <= 0 or light.intensity[c] <= 0:
+                continue
+            sigma = float(sc.sigma_t[c])
+            if sigma not in units:
+                units[sigma] = spot_unit_logs(sigma, sc.position, dirs, light.position, spot, x0, t_hit)
+            log_scale = math.log(sc.sigma_s[c] * light.intensity[c] / (4.0 * math.pi))
+            total[:, c] += np.exp(log_scale + units[sigma])
     return total
 
 
@@ -431,9 +455,10 @@ def spot_pixel_radiance(ss: SpotScene, rows: Sequence[int], cols: Sequence[int],
             base = base + spot_direct(ss, tr.point[k], tr.normal[k], albedo, tr.lit[:, k])
         value = base * transmittance(sc.sigma_t, t_hit)
         if airlight_on:
-            value = value + ray_airlight(points, sc.position, d, t_hit) + ray_spot_airlight(ss, sc.position, d,
-                                                                                              t_hit)
+            value = value + ray_airlight(points, sc.position, d, t_hit)
         out[k] = value
+    if airlight_on and len(dirs):
+        out += rays_spot_airlight(ss, dirs, tr.t_hit)
     return out
 
 
@@ -601,8 +626,9 @@ def spot_compare(image: np.ndarray, samples: SpotSamples, rel_tol: float = REL_T
         assert np.all(np.isfinite(got)), f"{label}: non-finite radiance at near-degenerate pixels"
         err = np.abs(got - ref) / samples.peak
         k, c = np.unravel_index(np.argmax(err), err.shape)
+        row, col = samples.rows_degenerate[k], samples.cols_degenerate[k]
         assert err[k, c] <= abs_tol, (
-            f"{label}: near-degenerate pixel (row {samples.rows_degenerate[k]}, col {samples.cols_degenerate[k]}) "
+            f"{label}: near-degenerate pixel (row {row}, col {col}) "
             f"channel {c}: rendered {got[k, c]:.7e}, reference {ref[k, c]:.7e}, error {err[k, c]:.3e} of the "
             f"image maximum {samples.peak:.4e}")
     return worst
@@ -610,8 +636,10 @@ def spot_compare(image: np.ndarray, samples: SpotSamples, rel_tol: float = REL_T
 
 # ---- scene helpers ------------------------------------------------------------------------------
 
-def spot(position: Sequence[float], direction: Sequence[float], intensity: Any = 100.0, cone_angle: float = 30.0,
-         edge: float = DEFAULT_EDGE, radius: float = DEFAULT_RADIUS) -> dict[str, Any]:
+def spot(position: Sequence[float], direction: Sequence[float], intensity: Any = 100.0,
+         cone_angle: float = 30.0, edge: float = DEFAULT_EDGE,
+         radius: float = DEFAULT_RADIUS) -> dict[str, Any]:
+    """A spot light for a scene dict (the renderer's format)."""
     return {"type": "spot", "position": [float(v) for v in position],
-            "direction": [float(v) for v in direction], "intensity": intensity, "cone_angle": float(cone_angle),
-            "edge": float(edge), "radius": float(radius)}
+            "direction": [float(v) for v in direction], "intensity": intensity,
+            "cone_angle": float(cone_angle), "edge": float(edge), "radius": float(radius)}

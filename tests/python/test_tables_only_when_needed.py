@@ -60,7 +60,8 @@ def test_lamps_in_fog_build_each_table_once():
     assert stats["surface_glow"]["bytes"] == 256 * 128 * 4
 
 
-SPOT = [{"type": "spot", "position": [0, 6, -10], "direction": [0, -1, 0], "intensity": 500, "cone_angle": 30}]
+SPOT = [{"type": "spot", "position": [0, 6, -10], "direction": [0, -1, 0], "intensity": 500,
+         "cone_angle": 30}]
 
 
 def test_spot_moment_table_only_for_spots_in_fog():
