@@ -7,13 +7,23 @@
 // Manual bilinear interpolation on a node-aligned grid (texel i at
 // X = i / (n - 1)): exact float32 arithmetic, identical on GPU and CPU (GL's
 // fixed-point texture filtering would not be).
-float table_bilinear(int table, int nx, int ny, float X, float Y) {
+// The cell (ix, iy) of an nx x ny node-aligned grid holding (X, Y) in [0, 1]^2,
+// clamped to the grid, and the position (ax, ay) in [0, 1]^2 inside it.
+void table_cell(int nx, int ny, float X, float Y, OUT(int) ix, OUT(int) iy, OUT(float) ax, OUT(float) ay) {
     float fx = clamp(X, 0.0f, 1.0f) * float(nx - 1);
     float fy = clamp(Y, 0.0f, 1.0f) * float(ny - 1);
-    int ix = min(int(fx), nx - 2);
-    int iy = min(int(fy), ny - 2);
-    float ax = fx - float(ix);
-    float ay = fy - float(iy);
+    ix = min(int(fx), nx - 2);
+    iy = min(int(fy), ny - 2);
+    ax = fx - float(ix);
+    ay = fy - float(iy);
+}
+
+float table_bilinear(int table, int nx, int ny, float X, float Y) {
+    int ix;
+    int iy;
+    float ax;
+    float ay;
+    table_cell(nx, ny, X, Y, ix, iy, ax, ay);
     float bottom = mix(table_texel(table, ix, iy), table_texel(table, ix + 1, iy), ax);
     float top = mix(table_texel(table, ix, iy + 1), table_texel(table, ix + 1, iy + 1), ax);
     return mix(bottom, top, ay);
@@ -29,12 +39,11 @@ bool negligible(vec3 bound, vec3 so_far) {
 
 // The same for a table of four channels (RGBA texels, table_texel4).
 vec4 table_bilinear4(int table, int nx, int ny, float X, float Y) {
-    float fx = clamp(X, 0.0f, 1.0f) * float(nx - 1);
-    float fy = clamp(Y, 0.0f, 1.0f) * float(ny - 1);
-    int ix = min(int(fx), nx - 2);
-    int iy = min(int(fy), ny - 2);
-    float ax = fx - float(ix);
-    float ay = fy - float(iy);
+    int ix;
+    int iy;
+    float ax;
+    float ay;
+    table_cell(nx, ny, X, Y, ix, iy, ax, ay);
     vec4 bottom = mix(table_texel4(table, ix, iy), table_texel4(table, ix + 1, iy), ax);
     vec4 top = mix(table_texel4(table, ix, iy + 1), table_texel4(table, ix + 1, iy + 1), ax);
     return mix(bottom, top, ay);

@@ -97,24 +97,6 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
     return irradiance;
 }
 
-// Brute-force airlight of one light on [x0, x1]: the midpoint rule with
-// frame.quality.y steps on the defining integral of MODELS.md section 1,
-// escaping rays cut at frame.quality.z metres. For benchmarks only.
-vec3 airlight_march(vec3 light_position, vec3 intensity, vec3 origin, vec3 dir, float x0, float x1) {
-    float x_end = min(x1, frame.quality.z);
-    int steps = int(frame.quality.y);
-    float dx = (x_end - x0) / float(steps);
-    vec3 sigma_t = vec3(frame.sigma_t);
-    vec3 sum = vec3(0.0f);
-    for (int k = 0; k < steps; ++k) {
-        float x = x0 + (float(k) + 0.5f) * dx;
-        vec3 to_light = light_position - (origin + x * dir);
-        float d2 = dot(to_light, to_light);
-        sum += exp(-sigma_t * (x + sqrt(d2))) / d2;
-    }
-    return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
-}
-
 // Airlight of point light `light` over the visible part [0, x_end] of the
 // view ray (MODELS.md section 1): sigma_s I / (2 pi h) times the segment
 // integral of airlight.glsl. A camera inside the lamp's sphere sees fog from
@@ -133,7 +115,7 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
     if (negligible(scale * (0.5f * PI) * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
-    if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), origin, dir, x0, x_end);
+    if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, origin, dir, x0, x_end);
     // The scale goes into the exponent (airlight_tail); channels without
     // scattering or light have none.
     if (GREY_MEDIUM) {
@@ -211,7 +193,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         }
     }
     if (HAS_SPOT_AIRLIGHT) {
-        for (int i = 0; i < spot_light_count(); ++i) radiance += spot_light_airlight(spot_light(i), dir, t_hit, radiance);
+        for (int i = 0; i < spot_light_count(); ++i) radiance += spot_light_airlight(i, dir, t_hit, radiance);
     }
     return radiance;
 }

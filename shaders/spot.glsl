@@ -188,10 +188,14 @@ float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, fl
     return max(J, 0.0f) * exp(arg0 + log(scale));
 }
 
-// Brute-force airlight of a spot on [x0, x1] (benchmarks): the midpoint rule on
-// the defining integral with the profile evaluated at each step.
-vec3 spot_airlight_march(SpotLightGpu s, vec3 origin, vec3 dir, float x0, float x1) {
-    vec3 position = vec3(s.world_position);
+// Brute-force airlight of a point light, or of spot number spot_index (>= 0),
+// on [x0, x1]: the midpoint rule with frame.quality.y steps on the defining
+// integral (MODELS.md sections 1, 2), escaping rays cut at frame.quality.z
+// metres. For benchmarks only.
+vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, vec3 origin, vec3 dir, float x0, float x1) {
+    bool spot = spot_index >= 0;
+    SpotLightGpu s;
+    if (spot) s = spot_light(spot_index);
     float x_end = min(x1, frame.quality.z);
     int steps = int(frame.quality.y);
     float dx = (x_end - x0) / float(steps);
@@ -199,20 +203,22 @@ vec3 spot_airlight_march(SpotLightGpu s, vec3 origin, vec3 dir, float x0, float 
     vec3 sum = vec3(0.0f);
     for (int k = 0; k < steps; ++k) {
         float x = x0 + (float(k) + 0.5f) * dx;
-        vec3 from_light = origin + x * dir - position;
+        vec3 from_light = origin + x * dir - light_position;
         float d2 = dot(from_light, from_light);
         float d = sqrt(d2);
-        sum += spot_profile_toward(s, from_light / d) * exp(-sigma_t * (x + d)) / d2;
+        float profile = spot ? spot_profile_toward(s, from_light / d) : 1.0f;
+        sum += profile * exp(-sigma_t * (x + d)) / d2;
     }
-    return vec3(frame.sigma_s) * vec3(s.intensity_edge) * sum * (dx / (4.0f * PI));
+    return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
 }
 
-// Airlight of spot `s` over the visible part [0, x_end] of the view ray from
+// Airlight of spot number spot_index over the visible part [0, x_end] of the view ray from
 // the camera (MODELS.md section 2): only the lit part of the ray scatters. A
 // camera inside the lamp's sphere sees fog from where the ray leaves it.
 // Skipped when the point-light bound (the profile is <= 1) is negligible
 // against `so_far`.
-vec3 spot_light_airlight(SpotLightGpu s, vec3 dir, float x_end, vec3 so_far) {
+vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
+    SpotLightGpu s = spot_light(spot_index);
     vec3 Sr = vec3(s.relative_position_radius);
     float radius = s.relative_position_radius.w;
     float dist = length(Sr);
@@ -249,7 +255,10 @@ vec3 spot_light_airlight(SpotLightGpu s, vec3 dir, float x_end, vec3 so_far) {
     bool wall_hi;
     float tau_end = x_end >= NO_HIT ? NO_HIT : x_end - r.b;
     if (!spot_lit_interval(s, r, x0 - r.b, tau_end, lo, hi, wall_lo, wall_hi)) return vec3(0.0f);
-    if (AIRLIGHT_MARCH) return spot_airlight_march(s, vec3(frame.camera_position), dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
+    if (AIRLIGHT_MARCH) {
+        return airlight_march(vec3(s.world_position), vec3(s.intensity_edge), spot_index, vec3(frame.camera_position),
+                              dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
+    }
     float clip_length = x_end - x0;
     if (GREY_MEDIUM) {
         float peak = max(max(scale.x, scale.y), scale.z);
