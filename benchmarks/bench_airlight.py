@@ -45,7 +45,18 @@ ALBEDO = 0.9
 def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.0,
                  light_type: str = "point") -> dict:
     """A straight street along -z: lamps 6 m high every 15 m, alternating sides;
-    with light_type "spot", each lamp is a 35-degree spot aimed down and across the road."""
+    with light_type "spot", each lamp is a 35-degree spot aimed down and across the road;
+    with "headlights", the lights are lamps/2 cars' headlight pairs (airlight.headlights),
+    oncoming in the left lane and driving away in the right one, 12 m apart."""
+    if light_type == "headlights":
+        lights = []
+        for car in range(max(lamps // 2, 1)):
+            oncoming = car % 2 == 0
+            position = [-1.8 if oncoming else 1.8, 0.0, -15.0 - 12.0 * car]
+            lights += airlight.headlights(position, 180.0 if oncoming else 0.0)
+        scene = street_scene(0, width, height, surface_albedo)
+        scene["lights"] = lights[:lamps]
+        return scene
     lights = []
     for i in range(lamps):
         side = -1 if i % 2 == 0 else 1
@@ -252,8 +263,9 @@ def main() -> None:
     ap.add_argument("--height", type=int, default=360)
     ap.add_argument("--samples", type=int, default=300)
     ap.add_argument("--backends", nargs="+", default=airlight.available_backends())
-    ap.add_argument("--light-type", choices=("point", "spot"), default="point",
-                    help="street lamps as point lights (MODELS.md section 1) or as spots (section 2)")
+    ap.add_argument("--light-type", choices=("point", "spot", "headlights"), default="point",
+                    help="street lamps as point lights (MODELS.md section 1) or spots (section 2), "
+                         "or cars' headlights (spots seen along their beams)")
     default_plot = Path(__file__).resolve().parents[1] / "docs/images/bench_airlight.png"
     ap.add_argument("--plot", default=str(default_plot))
     args = ap.parse_args()
