@@ -13,6 +13,7 @@ from typing import Any, Callable
 
 import numpy as np
 import pytest
+from scene_edit import delete_at, set_at
 
 import airlight
 
@@ -90,28 +91,8 @@ def test_scene_of_spots_only_and_no_spots() -> None:
 # --- bad spot input ------------------------------------------------------------
 
 
-def _set(path: str, value: Any) -> Callable[[dict], None]:
-    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
-
-    def mutate(scene: dict) -> None:
-        node = scene
-        for k in keys[:-1]:
-            node = node[k]
-        node[keys[-1]] = value
-
-    return mutate
-
-
-def _delete(path: str) -> Callable[[dict], None]:
-    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
-
-    def mutate(scene: dict) -> None:
-        node = scene
-        for k in keys[:-1]:
-            node = node[k]
-        del node[keys[-1]]
-
-    return mutate
+_set = set_at
+_delete = delete_at
 
 
 def _append_spot(**changes: Any) -> Callable[[dict], None]:

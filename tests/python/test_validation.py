@@ -13,6 +13,7 @@ import numpy as np
 import pytest
 from hypothesis import HealthCheck, assume, given, settings
 from hypothesis import strategies as st
+from scene_edit import delete_at, set_at
 
 import airlight
 
@@ -33,29 +34,8 @@ VALID: dict[str, Any] = {
 }
 
 
-def _set(path: str, value: Any) -> Callable[[dict], None]:
-    """Mutation setting the dotted/indexed ``path`` (e.g. "surfaces[1].max") to value."""
-    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
-
-    def mutate(scene: dict) -> None:
-        node = scene
-        for k in keys[:-1]:
-            node = node[k]
-        node[keys[-1]] = value
-
-    return mutate
-
-
-def _delete(path: str) -> Callable[[dict], None]:
-    keys = [int(k) if k.isdigit() else k for k in re.findall(r"[^.\[\]]+", path)]
-
-    def mutate(scene: dict) -> None:
-        node = scene
-        for k in keys[:-1]:
-            node = node[k]
-        del node[keys[-1]]
-
-    return mutate
+_set = set_at
+_delete = delete_at
 
 
 def _rename(path: str, new_key: str) -> Callable[[dict], None]:
