@@ -121,14 +121,8 @@ FrameData make_frame_data(const Scene& scene) {
     for (int c = 0; c < 3; ++c)
         if (sigma_s[c] > 0.0f) thinnest = std::min(thinnest, sigma_t[c]);
     const float march_far = scattering ? farthest + 16.0f / thinnest : 0.0f;
-    // Upper bound of the glow table G over all (T, theta_s), with a margin
-    // for its interpolation error, for the culling bound of the surface glow.
-    float glow_bound = 0.0f;
-    if (scattering && !lights.empty()) {
-        const std::vector<float>& log_glow = surface_glow_table().texels;
-        glow_bound = 1.01f * std::exp(*std::max_element(log_glow.begin(), log_glow.end()));
-    }
-    f.quality = glm::vec4(scene.quality.cull_fraction, float(scene.quality.march_steps), march_far, glow_bound);
+    f.quality = glm::vec4(scene.quality.cull_fraction, float(scene.quality.march_steps), march_far,
+                          float(scene.quality.spot_glow_samples));
     // Surfaces: the planes (unbounded, tested one by one), then the bounded
     // surfaces ordered by the leaves of a BVH built over them.
     std::vector<BoundedSurface> bounded;
@@ -172,7 +166,10 @@ FrameData make_frame_data(const Scene& scene) {
     data.features.spot_airlight = scattering && !data.spot_lights.empty();
     data.features.airlight_march =
         (data.features.airlight || data.features.spot_airlight) && scene.quality.airlight == AirlightMethod::march;
-    if (data.features.spot_airlight && !data.features.airlight_march) data.spot_moments = &spot_moment_table();
+    // The spot table serves the view-ray airlight (unless marched) and the
+    // spots' surface glow.
+    if (data.features.spot_airlight && (!data.features.airlight_march || data.features.surfaces))
+        data.spot_moments = &spot_moment_table();
     if (data.features.airlight) {
         data.surface_glow = &surface_glow_table();
         if (!data.features.airlight_march) data.airlight_tail = &airlight_tail_table();

@@ -419,7 +419,7 @@ double json_number(float f) {
 json json_vec3(const glm::vec3& v) { return json::array({json_number(v.x), json_number(v.y), json_number(v.z)}); }
 
 Quality parse_quality(const Obj& o) {
-    o.check_keys({"airlight", "march_steps", "cull_fraction"});
+    o.check_keys({"airlight", "march_steps", "cull_fraction", "spot_glow_samples"});
     Quality q;
     if (auto v = o.opt("airlight")) q.airlight = read_enum(*v, "airlight", airlight_methods);
     if (auto v = o.opt("march_steps")) q.march_steps = read_int(*v, 1, 65536);
@@ -427,6 +427,10 @@ Quality parse_quality(const Obj& o) {
         double x = read_number(*v);
         if (x < 0 || x > 0.01) fail(Kind::value, v->field, "must be in [0, 0.01]");
         q.cull_fraction = static_cast<float>(x);
+    }
+    if (auto v = o.opt("spot_glow_samples")) {
+        q.spot_glow_samples = read_int(*v, 4, 64);
+        if (q.spot_glow_samples % 4 != 0) fail(Kind::value, v->field, "must be a multiple of 4");
     }
     return q;
 }
@@ -503,7 +507,8 @@ json scene_to_json_value(const Scene& s) {
     j["background"] = json_vec3(s.background);
     j["quality"] = {{"airlight", name_of(airlight_methods, s.quality.airlight)},
                     {"march_steps", s.quality.march_steps},
-                    {"cull_fraction", json_number(s.quality.cull_fraction)}};
+                    {"cull_fraction", json_number(s.quality.cull_fraction)},
+                    {"spot_glow_samples", s.quality.spot_glow_samples}};
     return j;
 }
 

@@ -49,6 +49,16 @@ vec4 table_bilinear4(int table, int nx, int ny, float X, float Y) {
     return mix(bottom, top, ay);
 }
 
+// The 4-point Gauss-Legendre rule on [-1, 1]: node and weight k (0..3).
+float gauss4_node(int k) {
+    return k == 0 ? -0.8611363115940526f
+                  : (k == 1 ? -0.3399810435848563f : (k == 2 ? 0.3399810435848563f : 0.8611363115940526f));
+}
+
+float gauss4_weight(int k) {
+    return (k == 0 || k == 3) ? 0.3478548451374538f : 0.6521451548625461f;
+}
+
 // ---- Airlight along a view ray -------------------------------------------
 // Geometry of one light relative to the ray o + x d: b = (S - o).d is the
 // distance along the ray to the closest approach, h > 0 the closest distance.

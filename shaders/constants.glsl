@@ -25,6 +25,10 @@ CONST int SURFACE_GLOW_NX = 256;
 CONST int SURFACE_GLOW_NY = 128;
 CONST float SURFACE_GLOW_T_MAX = 200.0f;
 CONST float SURFACE_GLOW_T_SCALE = 0.05f;
+// An upper bound of G over all (T, theta_s), for the culling bounds of the
+// point lamps' and the spots' glow: G is largest at T = 0, theta_s = 0, where
+// G = pi^2/2 + pi = 8.0762 (tests/cpp/test_tables checks both).
+CONST float SURFACE_GLOW_G_BOUND = 8.08f;
 
 
 // Spot moments (docs/spot_table.md): RGBA texel (S, M1/N1, M2/N2, 0) on the

@@ -12,7 +12,7 @@ struct FrameUniforms {
     vec4 sigma_s;          // rgb: medium scattering (1/m) = albedo * sigma_t
     vec4 background;       // rgb: radiance of escaping rays, before attenuation
     ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
-    vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: bound of G
+    vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: spot glow samples (spot_surface_glow)
     ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces,
                            // zw: pixel origin of the tile being drawn (GL backend; 0 on the CPU)
     ivec4 light_counts;    // x: spot lights

@@ -60,7 +60,7 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         vec3 attenuation = transmittance(dist);
         vec3 direct = cos_theta > 0.0f ? intensity * (cos_theta / max(dist2, radius * radius)) * attenuation : vec3(0.0f);
         vec3 glow_bound = vec3(0.0f);
-        if (HAS_AIRLIGHT) glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (frame.quality.w / (2.0f * PI * max(dist, radius)));
+        if (HAS_AIRLIGHT) glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
         if (negligible(direct + glow_bound, irradiance)) continue;
         if (HAS_AIRLIGHT) irradiance += surface_glow_irradiance(intensity, dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
@@ -72,8 +72,9 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
 
 // Irradiance at p (normal n) from the spotlights: the profile in the direction
 // of p, inverse-square falloff, Lambert's cosine, attenuation and hard shadows
-// (MODELS.md section 2). The light spots scatter onto surfaces (their glow)
-// is not modelled yet.
+// (MODELS.md section 2); plus, in a scattering medium, the light each spot
+// scatters once on the way (spot_surface_glow, not shadowed), bounded for
+// culling by the glow of a point lamp of intensity I0 (the profile is <= 1).
 vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
     vec3 irradiance = vec3(0.0f);
     vec3 shadow_origin = p + surface_offset(p) * n;
@@ -86,11 +87,17 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
         if (dist <= 0.0f) continue;
         vec3 l = to_light / dist;
         float cos_theta = dot(n, l);
-        if (cos_theta <= 0.0f) continue;
-        float profile = spot_profile_toward(s, -l);
+        float profile = cos_theta > 0.0f ? spot_profile_toward(s, -l) : 0.0f;
+        vec3 intensity = vec3(s.intensity_edge);
+        vec3 attenuation = transmittance(dist);
+        vec3 direct = intensity * (max(profile, 0.0f) * cos_theta / max(dist2, radius * radius)) * attenuation;
+        if (profile <= 0.0f) direct = vec3(0.0f);
+        vec3 glow_bound = vec3(0.0f);
+        if (HAS_SPOT_AIRLIGHT)
+            glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
+        if (negligible(direct + glow_bound, irradiance + so_far)) continue;
+        if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.quality.w));
         if (profile <= 0.0f) continue;
-        vec3 direct = vec3(s.intensity_edge) * (profile * cos_theta / max(dist2, radius * radius)) * transmittance(dist);
-        if (negligible(direct, irradiance + so_far)) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
         irradiance += direct;
     }

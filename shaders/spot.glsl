@@ -44,6 +44,31 @@ struct SpotRay {
     float na;
 };
 
+// The closest-point frame of the ray origin + x dir (unit) seen from a spot
+// at origin + rel with unit axis `axis` (docs/spot_table.md section 4):
+// m = d x c1 / |c1| points from the closest ray point to the spot, n = -c1 / |c1|,
+// c1 = rel x d. A ray through the spot's centre (c1 = 0) takes any unit m
+// across the ray; h is floored at h_floor (> 0) for the 1/h scale only.
+SpotRay spot_ray_frame(vec3 rel, vec3 axis, vec3 dir, float h_floor) {
+    SpotRay r;
+    r.b = dot(rel, dir);
+    vec3 c1 = cross_accurate(rel, dir);
+    float closest = length(c1);
+    vec3 m;
+    if (closest > 0.0f) {
+        m = cross(dir, c1) / closest;
+    } else {
+        vec3 across = cross(dir, abs(dir.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f));
+        m = normalize(across);
+    }
+    vec3 n = cross(dir, m);
+    r.h = max(closest, h_floor);
+    r.da = dot(dir, axis);
+    r.ma = dot(m, axis);
+    r.na = dot(n, axis);
+    return r;
+}
+
 // True when tau lies in the forward nappe of the cone (the mirror nappe of
 // the quadratic is rejected here).
 bool spot_lit_at(SpotLightGpu s, SpotRay r, float tau) {
@@ -174,14 +199,11 @@ float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, fl
         float beta = s.cone.z;
         J = 0.0f;
         for (int k = 0; k < 4; ++k) {
-            float node = k == 0 ? -0.8611363115940526f
-                                : (k == 1 ? -0.3399810435848563f : (k == 2 ? 0.3399810435848563f : 0.8611363115940526f));
-            float weight = (k == 0 || k == 3) ? 0.3478548451374538f : 0.6521451548625461f;
-            float D = dv * 0.5f * (1.0f + node);
+            float D = dv * 0.5f * (1.0f + gauss4_node(k));
             float sD = sin(D);
             float I = max(profile0 - 2.0f * beta * ct0 * sD * sD + beta * g0 * sin(2.0f * D), 0.0f);
             float w = D < cv0 ? exp(-u * sD / (s0 * sin(cv0 - D))) : 0.0f;
-            J += 0.5f * weight * I * w;
+            J += 0.5f * gauss4_weight(k) * I * w;
         }
         J *= dv;
     }
@@ -222,26 +244,7 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
     vec3 Sr = vec3(s.relative_position_radius);
     float radius = s.relative_position_radius.w;
     float dist = length(Sr);
-    SpotRay r;
-    r.b = dot(Sr, dir);
-    vec3 c1 = cross_accurate(Sr, dir);
-    float closest = length(c1);
-    // The frame (d, m, n): m = d x c1 / |c1| points from the closest ray point
-    // to the spot, n = -c1 / |c1|. A ray through the spot's centre (c1 = 0)
-    // takes any unit m across the ray; h is only floored for the 1/h scale.
-    vec3 axis = vec3(s.axis_cos);
-    vec3 m;
-    if (closest > 0.0f) {
-        m = cross(dir, c1) / closest;
-    } else {
-        vec3 across = cross(dir, abs(dir.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f));
-        m = normalize(across);
-    }
-    vec3 n = cross(dir, m);
-    r.h = max(closest, 1.0e-6f * max(dist, radius));
-    r.da = dot(dir, axis);
-    r.ma = dot(m, axis);
-    r.na = dot(n, axis);
+    SpotRay r = spot_ray_frame(Sr, vec3(s.axis_cos), dir, 1.0e-6f * max(dist, radius));
     float x0 = 0.0f;
     if (dist < radius) x0 = r.b + sqrt(max(radius * radius - r.h * r.h, 0.0f));
     if (x0 >= x_end) return vec3(0.0f);
@@ -269,4 +272,144 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
         scale.x > 0.0f ? spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, scale.x) : 0.0f,
         scale.y > 0.0f ? spot_airlight_channel(s, r, sigma_t.y, lo, hi, wall_lo, wall_hi, clip_length, scale.y) : 0.0f,
         scale.z > 0.0f ? spot_airlight_channel(s, r, sigma_t.z, lo, hi, wall_lo, wall_hi, clip_length, scale.z) : 0.0f);
+}
+
+// ---- Light a spot scatters onto surfaces (its glow) ------------------------
+// Irradiance at a surface point p (unit normal n) from the light of spot s
+// scattered once in the medium, unshadowed like the point lamps' glow
+// (MODELS.md sections 1-2; docs/spot_table.md section 9):
+//   E = int over the beam's directions w of I(theta_w) / I0 * A(w) dw,
+// where A(w) is the airlight seen from the spot along w of a "spot" at p with
+// axis n, cone angle 90 degrees, q = 0 and intensity I0: a Lambertian receiver
+// weights the light arriving from y by max(cos psi, 0) / |y - p|^2 exactly as
+// a cosine-profile emitter would, so spot_airlight_channel gives A exactly.
+// The outer integral is done in polar coordinates (alpha, phi) about the
+// direction from the spot to p, where A ~ 1 / sin(alpha) is cancelled by the
+// Jacobian sin(alpha). Along each phi the beam is an exact arc alpha in
+// [a0, a1], integrated by max(samples / 8, 1) 4-point Gauss-Legendre panels in
+// log(alpha + alpha_c), alpha_c = min(1 / sqrt(1 + sigma_t D), |n.(p - S)| / D):
+// dense where the light scattered near p gives a plateau (alpha < alpha_c) and
+// geometric along the 1 / alpha tail of the light scattered near the spot.
+// phi: the circle (p inside the beam or its mirror cone), or the wedge
+// [-phi_m, phi_m] of the directions that meet the beam with
+// phi = phi_m sin(pi sv / 2) absorbing its square-root ends, is cut where the
+// integrand kinks (the directions along the receiver's plane, phi_n +- pi/2),
+// and each piece gets samples / 4 panels of 4-point Gauss-Legendre.
+// Measured error: docs/spot_table.md section 9.
+vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
+    vec3 v = p - vec3(s.world_position);
+    float D = length(v);
+    if (!(D > 0.0f)) return vec3(0.0f);
+    vec3 to_p = v / D;
+    float radius = s.relative_position_radius.w;
+    if (D < radius) {  // inside the lamp's sphere: held at its value on the sphere
+        D = radius;
+        v = to_p * D;
+    }
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 numerator = vec3(frame.sigma_s) * vec3(s.intensity_edge) / (2.0f * PI);  // scale = numerator / h
+    float peak = max(max(numerator.x, numerator.y), numerator.z);
+    if (!(peak > 0.0f)) return vec3(0.0f);
+    // The receiver as a spot at p seen from the spot's centre.
+    SpotLightGpu receiver;
+    receiver.relative_position_radius = vec4(v, 0.0f);
+    receiver.world_position = vec4(p, 0.0f);
+    receiver.axis_cos = vec4(n, 0.0f);
+    receiver.intensity_edge = vec4(vec3(s.intensity_edge), 0.0f);
+    receiver.cone = vec4(1.0f, 1.0f, 1.0f, 0.0f);
+    // The frame (to_p, e1, e2), e1 towards the axis: a.w = cos(alpha) ct + sin(alpha) st cos(phi).
+    vec3 axis = vec3(s.axis_cos);
+    float cos_a = s.axis_cos.w;
+    float ct = dot(axis, to_p);
+    vec3 toward_axis = axis - ct * to_p;
+    float st = length(toward_axis);
+    vec3 e1 = st > 1.0e-7f ? toward_axis / st
+                           : normalize(cross(to_p, abs(to_p.x) < 0.9f ? vec3(1.0f, 0.0f, 0.0f) : vec3(0.0f, 1.0f, 0.0f)));
+    vec3 e2 = cross(to_p, e1);
+    float sigma_max = max(max(sigma_t.x, sigma_t.y), sigma_t.z);
+    float n_to_p = dot(n, to_p);
+    float alpha_c = min(1.0f / sqrt(1.0f + sigma_max * D), max(abs(n_to_p), 1.0e-4f));
+    // Azimuth of the receiver's normal about to_p: at phi_n +- pi/2 the
+    // directions cross the receiver's plane near p, where A jumps (the near
+    // part of the ray is lit or not); the midpoint rule puts cell edges there.
+    vec3 n_across = n - n_to_p * to_p;
+    float phi_n = dot(n_across, n_across) > 1.0e-12f ? atan(dot(n_across, e2), dot(n_across, e1)) : 0.0f;
+    bool inside = ct >= cos_a;
+    bool every_phi = inside || ct <= -cos_a;
+    float phi_m = every_phi ? PI : acos(min(sqrt(max(cos_a * cos_a - ct * ct, 0.0f)) / st, 1.0f));
+    // phi pieces, split where the receiver's plane makes the integrand kink
+    // (phi_n +- pi/2), in the variable sv: phi = sv over the whole circle,
+    // phi = phi_m sin(pi sv / 2) over the wedge sv in [-1, 1].
+    float edges[4];
+    int pieces = 0;
+    if (every_phi) {
+        edges[0] = phi_n - 0.5f * PI;
+        edges[1] = phi_n + 0.5f * PI;
+        edges[2] = phi_n + 1.5f * PI;
+        pieces = 2;
+    } else {
+        float k0 = phi_n - 0.5f * PI;  // in (-3 pi / 2, pi / 2]
+        float k1 = phi_n + 0.5f * PI;  // in (-pi / 2, 3 pi / 2]
+        if (k0 <= -PI) k0 += 2.0f * PI;
+        if (k1 > PI) k1 -= 2.0f * PI;
+        float lo_k = min(k0, k1);
+        float hi_k = max(k0, k1);
+        edges[0] = -1.0f;
+        pieces = 1;
+        if (abs(lo_k) < phi_m) edges[pieces++] = (2.0f / PI) * asin(lo_k / phi_m);
+        if (abs(hi_k) < phi_m) edges[pieces++] = (2.0f / PI) * asin(hi_k / phi_m);
+        edges[pieces] = 1.0f;
+    }
+    int phi_panels = max(samples / 4, 1);
+    int alpha_panels = max(samples / 8, 1);
+    vec3 E = vec3(0.0f);
+    for (int j = 0; j < 4 * phi_panels * pieces; ++j) {
+        int piece = j / (4 * phi_panels);
+        float width = (edges[piece + 1] - edges[piece]) / float(phi_panels);
+        float sv = edges[piece] + width * (float((j / 4) % phi_panels) + 0.5f * (1.0f + gauss4_node(j % 4)));
+        float phi = every_phi ? sv : phi_m * sin(0.5f * PI * sv);
+        float w_phi = 0.5f * width * gauss4_weight(j % 4) * (every_phi ? 1.0f : phi_m * (0.5f * PI) * cos(0.5f * PI * sv));
+        vec3 e = cos(phi) * e1 + sin(phi) * e2;
+        // The beam's arc on this half great circle: R cos(alpha - beta) >= cos A.
+        float x = ct;
+        float y = st * cos(phi);
+        float R = sqrt(x * x + y * y);
+        if (!(R > cos_a) || !(R > 0.0f)) continue;
+        float beta = atan(y, x);
+        float gamma = acos(min(cos_a / R, 1.0f));
+        float a0 = inside ? 0.0f : max(beta - gamma, 0.0f);
+        float a1 = min(beta + gamma, PI);
+        if (!(a1 > a0)) {  // beta < 0: the arc is the one about beta + 2 pi
+            a0 = max(beta + 2.0f * PI - gamma, 0.0f);
+            a1 = PI;
+        }
+        if (!(a1 > a0)) continue;
+        float w0 = log(a0 + alpha_c);
+        float dw = (log(a1 + alpha_c) - w0) / float(alpha_panels);
+        for (int k = 0; k < 4 * alpha_panels; ++k) {
+            float w = w0 + dw * (float(k / 4) + 0.5f * (1.0f + gauss4_node(k % 4)));
+            float alpha = exp(w) - alpha_c;
+            vec3 dir = cos(alpha) * to_p + sin(alpha) * e;
+            float profile = spot_profile_toward(s, dir);
+            if (!(profile > 0.0f)) continue;
+            SpotRay r = spot_ray_frame(v, n, dir, 1.0e-6f * D);
+            float lo;
+            float hi;
+            bool wall_lo;
+            bool wall_hi;
+            if (!spot_lit_interval(receiver, r, -r.b, NO_HIT, lo, hi, wall_lo, wall_hi)) continue;
+            float weight = w_phi * 0.5f * dw * gauss4_weight(k % 4) * (alpha + alpha_c) * sin(alpha) * profile;
+            if (GREY_MEDIUM) {
+                E += (weight * spot_airlight_channel(receiver, r, sigma_t.x, lo, hi, wall_lo, wall_hi, NO_HIT,
+                                                     peak / r.h)) * (numerator / peak);
+            } else {
+                for (int c = 0; c < 3; ++c) {
+                    if (numerator[c] > 0.0f)
+                        E[c] += weight * spot_airlight_channel(receiver, r, sigma_t[c], lo, hi, wall_lo, wall_hi,
+                                                               NO_HIT, numerator[c] / r.h);
+                }
+            }
+        }
+    }
+    return E;
 }

@@ -95,6 +95,10 @@ struct Quality {
     // below cull_fraction x the scene's reference radiance (docs/culling.md);
     // 0 disables culling.
     float cull_fraction = 1e-5f;
+    // Directions per azimuth ring and rings of the quadrature over a spot's
+    // beam that gives the light it scatters onto surfaces (a multiple of 4 in
+    // [4, 64]; docs/spot_table.md section 9 measures its error).
+    int spot_glow_samples = 12;
 };
 
 struct Scene {

@@ -141,19 +141,20 @@ void test_glow_quadrature_converged() {
 }
 
 void test_glow_limits() {
-    // T = 0, light straight above: G = int_0^pi (pi - g)/2 Phi(g, 0) dg with
-    // Phi = 2 pi cos g on g < pi/2: = pi int_0^{pi/2} (pi - g) cos g dg = pi (pi/2 + 1 - ... )
-    // int (pi - g) cos g dg from 0 to pi/2 = [(pi - g) sin g - cos g]_0^{pi/2} = pi/2 + 1.
-    const double expected = kPi * (kPi / 2.0 - 1.0 + 1.0 + 0.0);  // pi * (pi/2 - 0 + ... ) see below
-    (void)expected;
-    const double closed_form = kPi * (kPi / 2.0 + 1.0 - 1.0) + kPi * 1.0;  // = pi (pi/2 + 1) - pi + pi
-    CHECK_MSG(std::abs(surface_glow_exact(0.0, 0.0) / (kPi * (kPi / 2.0 + 1.0 - 1.0) + kPi) - 1.0) < 1e-9,
+    // T = 0, light straight above: G = pi int_0^{pi/2} (pi - g) cos g dg
+    // = pi [(pi - g) sin g - cos g]_0^{pi/2} = pi (pi/2 + 1) = pi^2/2 + pi.
+    const double closed_form = kPi * (kPi / 2.0 + 1.0);
+    CHECK_MSG(std::abs(surface_glow_exact(0.0, 0.0) / closed_form - 1.0) < 1e-9,
               std::to_string(surface_glow_exact(0.0, 0.0)) + " vs " + std::to_string(closed_form));
     // The table holds log G; its largest texel is G(0, theta_s = 0) (row Y = 1),
-    // and G(0, 0) exceeds G anywhere (the culling bound relies on it).
+    // and G(0, 0) exceeds G anywhere, so SURFACE_GLOW_G_BOUND bounds every
+    // lookup (bilinear interpolation never exceeds the largest texel): the
+    // culling bounds of the lamps' and spots' glow rely on it.
     const Table2D& t = surface_glow_table();
     const float top_left = t.texels[size_t(t.height - 1) * t.width];
     CHECK(*std::max_element(t.texels.begin(), t.texels.end()) == top_left);
+    CHECK(std::exp(double(top_left)) <= double(shader::SURFACE_GLOW_G_BOUND));
+    CHECK(closed_form <= double(shader::SURFACE_GLOW_G_BOUND));
     CHECK_MSG(std::abs(std::exp(double(top_left)) / surface_glow_exact(0.0, 0.0) - 1.0) < 1e-6,
               std::to_string(top_left));
     CHECK(std::all_of(t.texels.begin(), t.texels.end(), [](float v) { return std::isfinite(v); }));

@@ -116,6 +116,14 @@ BAD_SCENES = [
     ("unknown_top_level_key", _set("fog", 1), ValueError, "fog"),
     ("non_string_dict_key", _set("camera", {1: 2}), TypeError, "camera"),
     ("unsupported_python_type", _set("camera.position", {0, 1, 2}), TypeError, "camera.position"),
+    ("march_steps_zero", _set("quality", {"march_steps": 0}), ValueError, "quality.march_steps"),
+    ("cull_fraction_too_big", _set("quality", {"cull_fraction": 0.5}), ValueError, "quality.cull_fraction"),
+    ("spot_glow_samples_not_multiple_of_4", _set("quality", {"spot_glow_samples": 10}), ValueError,
+     "quality.spot_glow_samples"),
+    ("spot_glow_samples_too_many", _set("quality", {"spot_glow_samples": 68}), ValueError,
+     "quality.spot_glow_samples"),
+    ("spot_glow_samples_float", _set("quality", {"spot_glow_samples": 8.5}), ValueError,
+     "quality.spot_glow_samples"),
 ]
 
 
