@@ -286,8 +286,8 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
 // The outer integral is done in polar coordinates (alpha, phi) about the
 // direction from the spot to p, where A ~ 1 / sin(alpha) is cancelled by the
 // Jacobian sin(alpha). Along each phi the beam is an exact arc alpha in
-// [a0, a1], integrated by max(samples / 8, 1) 4-point Gauss-Legendre panels in
-// log(alpha + alpha_c), alpha_c = min(1 / sqrt(1 + sigma_t D), |n.(p - S)| / D):
+// [a0, a1], integrated by 4-point Gauss-Legendre panels in w =
+// log(alpha + alpha_c) (one per 24 / samples of w's range, at least one), alpha_c = min(1 / sqrt(1 + sigma_t D), |n.(p - S)| / D):
 // dense where the light scattered near p gives a plateau (alpha < alpha_c) and
 // geometric along the 1 / alpha tail of the light scattered near the spot.
 // phi: the circle (p inside the beam or its mirror cone), or the wedge
@@ -361,7 +361,6 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
         edges[pieces] = 1.0f;
     }
     int phi_panels = max(samples / 4, 1);
-    int alpha_panels = max(samples / 8, 1);
     vec3 E = vec3(0.0f);
     for (int j = 0; j < 4 * phi_panels * pieces; ++j) {
         int piece = j / (4 * phi_panels);
@@ -385,7 +384,10 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
         }
         if (!(a1 > a0)) continue;
         float w0 = log(a0 + alpha_c);
-        float dw = (log(a1 + alpha_c) - w0) / float(alpha_panels);
+        // Panels in proportion to the arc's length in w (e-folds of alpha + alpha_c).
+        float w_length = log(a1 + alpha_c) - w0;
+        int alpha_panels = clamp(int(ceil(w_length * float(samples) / 24.0f)), 1, 16);
+        float dw = w_length / float(alpha_panels);
         for (int k = 0; k < 4 * alpha_panels; ++k) {
             float w = w0 + dw * (float(k / 4) + 0.5f * (1.0f + gauss4_node(k % 4)));
             float alpha = exp(w) - alpha_c;
