@@ -274,6 +274,30 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
         scale.z > 0.0f ? spot_airlight_channel(s, r, sigma_t.z, lo, hi, wall_lo, wall_hi, clip_length, scale.z) : 0.0f);
 }
 
+// spot_lit_interval for a receiver "spot" (cone angle 90 degrees: the half-
+// space in front of a surface) on [tau_start, infinity): lit where
+// tau da - h ma >= 0, i.e. on one side of tau = h ma / da, the crossing of the
+// surface's plane, formed in the closest-point frame without cancellation.
+bool receiver_lit_interval(SpotRay r, float tau_start, OUT(float) lo, OUT(float) hi, OUT(bool) wall_lo,
+                           OUT(bool) wall_hi) {
+    lo = tau_start;
+    hi = NO_HIT;
+    wall_lo = false;
+    wall_hi = false;
+    if (r.da == 0.0f) return r.ma <= 0.0f;
+    float crossing = r.h * r.ma / r.da;
+    if (r.da > 0.0f) {
+        if (crossing > tau_start) {
+            lo = crossing;
+            wall_lo = true;
+        }
+        return true;
+    }
+    hi = crossing;
+    wall_hi = true;
+    return crossing > tau_start;
+}
+
 // ---- Light a spot scatters onto surfaces (its glow) ------------------------
 // Irradiance at a surface point p (unit normal n) from the light of spot s
 // scattered once in the medium, unshadowed like the point lamps' glow
@@ -399,7 +423,7 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
             float hi;
             bool wall_lo;
             bool wall_hi;
-            if (!spot_lit_interval(receiver, r, -r.b, NO_HIT, lo, hi, wall_lo, wall_hi)) continue;
+            if (!receiver_lit_interval(r, -r.b, lo, hi, wall_lo, wall_hi)) continue;
             float weight = w_phi * 0.5f * dw * gauss4_weight(k % 4) * (alpha + alpha_c) * sin(alpha) * profile;
             if (GREY_MEDIUM) {
                 E += (weight * spot_airlight_channel(receiver, r, sigma_t.x, lo, hi, wall_lo, wall_hi, NO_HIT,
