@@ -13,12 +13,17 @@
    (docs/airlight_table.md, built by another method): max relative pixel error of
    the two-spot image against the point-lamp image, lamp cores excluded.
 
-Timings are whole frames at 160x120 on a shared machine: compare ratios.
+3. Frame cost of the glow in the spot presets (320x180, both backends where
+   available): as shipped, with spot_glow_samples 8, and with black surfaces
+   (which skips all surface lighting, so the difference is the lighting).
+
+Timings are whole frames on a shared machine: compare ratios.
 """
 
 from __future__ import annotations
 
 import argparse
+import copy
 import time
 from typing import Any
 
@@ -116,6 +121,21 @@ def main() -> None:
                     core[max(y - 1, 0):y + 2, max(x - 1, 0):x + 2] = True
                 cells.append(f"n={n}: {max_rel(b, a, core):.1e}")
             print(f"  sigma_t {sigma:<6} lamp at {str(position):14} " + "  ".join(cells))
+
+
+    print("\n3. frame time of the spot presets at 320x180: as shipped | spot_glow_samples 8 | black surfaces")
+    for backend in airlight.available_backends():
+        frame_renderer = airlight.Renderer(backend)
+        for name in ("spotlights_crossing_004", "crane_searchlight"):
+            shipped = airlight.preset(name)
+            shipped["film"] = {"width": 320, "height": 180}
+            fewer = copy.deepcopy(shipped)
+            fewer["quality"] = dict(shipped.get("quality", {}), spot_glow_samples=8)
+            black = copy.deepcopy(shipped)
+            for surface in black["surfaces"]:
+                surface["albedo"] = 0.0
+            times = [1e3 * timed(frame_renderer, sc)[0] for sc in (shipped, fewer, black)]
+            print(f"  {backend:4} {name:24} " + " | ".join(f"{t:6.0f} ms" for t in times))
 
 
 if __name__ == "__main__":
