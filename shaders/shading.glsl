@@ -39,6 +39,13 @@ vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos
                 scaled_surface_glow(scale.z, sigma_t.z * dist, cos_theta_s));
 }
 
+// Upper bound of the once-scattered irradiance from a lamp of intensity I (or
+// a spot of axial intensity I, whose profile is <= 1) at distance dist:
+// sigma_s I e^{-T} G / (2 pi D) with G <= SURFACE_GLOW_G_BOUND, for culling.
+vec3 surface_glow_bound(vec3 intensity, vec3 attenuation, float dist, float radius) {
+    return vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
+}
+
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
 // lamps: inverse-square falloff, Lambert's cosine, attenuation exp(-sigma_t d)
 // along the lamp-to-point path and hard shadows from every surface; plus, in
@@ -59,8 +66,7 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         vec3 intensity = vec3(light.intensity);
         vec3 attenuation = transmittance(dist);
         vec3 direct = cos_theta > 0.0f ? intensity * (cos_theta / max(dist2, radius * radius)) * attenuation : vec3(0.0f);
-        vec3 glow_bound = vec3(0.0f);
-        if (HAS_AIRLIGHT) glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
+        vec3 glow_bound = HAS_AIRLIGHT ? surface_glow_bound(intensity, attenuation, dist, radius) : vec3(0.0f);
         if (negligible(direct + glow_bound, irradiance)) continue;
         if (HAS_AIRLIGHT) irradiance += surface_glow_irradiance(intensity, dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
@@ -92,9 +98,7 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
         vec3 attenuation = transmittance(dist);
         vec3 direct = intensity * (max(profile, 0.0f) * cos_theta / max(dist2, radius * radius)) * attenuation;
         if (profile <= 0.0f) direct = vec3(0.0f);
-        vec3 glow_bound = vec3(0.0f);
-        if (HAS_SPOT_AIRLIGHT)
-            glow_bound = vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
+        vec3 glow_bound = HAS_SPOT_AIRLIGHT ? surface_glow_bound(intensity, attenuation, dist, radius) : vec3(0.0f);
         if (negligible(direct + glow_bound, irradiance + so_far)) continue;
         if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.quality.w));
         if (profile <= 0.0f) continue;

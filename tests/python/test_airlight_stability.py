@@ -29,15 +29,10 @@ from airlight_reference import (
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from image_checks import finite_non_negative as _finite_non_negative
 
 BACKENDS = ("cpu", "gl")
 FLOAT32_FLOOR = 1e-37  # relative to a light's own radiance scale: below it float32 may give 0
-
-
-def _finite_non_negative(image: np.ndarray, label: str) -> None:
-    image = np.asarray(image)
-    assert np.all(np.isfinite(image)), f"{label}: {np.count_nonzero(~np.isfinite(image))} non-finite values"
-    assert np.all(image >= 0), f"{label}: negative radiance, min {image.min()}"
 
 
 def _one_pixel(backend: str, scene: dict) -> np.ndarray:

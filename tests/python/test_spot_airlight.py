@@ -51,6 +51,8 @@ from airlight_reference import (
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from image_checks import finite_non_negative as _finite_non_negative
+from image_checks import no_jumps as _no_jumps
 from spot_reference import (
     lit_interval,
     make_spot,
@@ -79,12 +81,6 @@ def _check(scene: dict, backend: str, label: str, min_values: int = 20) -> None:
     samples = spot_samples(scene)
     image = get_renderer(backend).render(scene)
     spot_compare(image, samples, min_values=min_values, label=f"{label} [{backend}]")
-
-
-def _finite_non_negative(image: np.ndarray, label: str) -> None:
-    image = np.asarray(image)
-    assert np.all(np.isfinite(image)), f"{label}: {np.count_nonzero(~np.isfinite(image))} non-finite values"
-    assert np.all(image >= 0), f"{label}: negative radiance, min {image.min()}"
 
 
 # ---- scenes --------------------------------------------------------------------------------------
@@ -612,17 +608,6 @@ def test_random_spot_scenes_are_finite_and_non_negative(scene):
         image = np.asarray(get_renderer(backend).render(scene))
         assert image.shape == (16, 24, 3)
         _finite_non_negative(image, f"[{backend}]")
-
-
-def _no_jumps(values: np.ndarray, label: str, floor: float, factor: float = 4.0) -> None:
-    """Every step between neighbours is at most `factor` times the largest of the (up to
-    four) steps around it, plus `floor`: a kink passes, a jump does not."""
-    steps = np.abs(np.diff(values))
-    for k in range(len(steps)):
-        around = np.concatenate([steps[max(0, k - 2):k], steps[k + 1:k + 3]])
-        assert steps[k] <= factor * around.max() + floor, (
-            f"{label}: jump of {steps[k]:.4e} between samples {k} and {k + 1} ({values[k]:.6e} -> "
-            f"{values[k + 1]:.6e}); steps around it {around}")
 
 
 WALL_VIEWS = {  # directions of the camera, relative to (axis, outward normal of the wall)

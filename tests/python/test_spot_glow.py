@@ -60,6 +60,8 @@ from airlight_reference import (
 )
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
+from image_checks import finite_non_negative as _finite_non_negative
+from image_checks import no_jumps as _no_jumps
 from scipy.integrate import nquad, quad
 from scipy.ndimage import distance_transform_edt
 from spot_reference import (
@@ -89,12 +91,6 @@ DIM_FRACTION = 1e-3  # values below this fraction of the sampled maximum are not
 def _unit(v: Any) -> np.ndarray:
     v = np.asarray(v, dtype=np.float64)
     return v / np.linalg.norm(v)
-
-
-def _finite_non_negative(image: np.ndarray, label: str) -> None:
-    image = np.asarray(image)
-    assert np.all(np.isfinite(image)), f"{label}: {np.count_nonzero(~np.isfinite(image))} non-finite values"
-    assert np.all(image >= 0), f"{label}: negative radiance, min {image.min()}"
 
 
 # ---- the reference itself (no renderer) ----------------------------------------------------------------
@@ -616,17 +612,6 @@ def test_random_spots_over_a_road_are_finite_and_non_negative(scene):
         image = np.asarray(get_renderer(backend).render(scene))
         assert image.shape == (12, 16, 3)
         _finite_non_negative(image, f"[{backend}]")
-
-
-def _no_jumps(values: np.ndarray, label: str, floor: float, factor: float = 4.0) -> None:
-    """Every step between neighbours is at most `factor` times the largest of the (up to
-    four) steps around it, plus `floor`: a kink passes, a jump does not."""
-    steps = np.abs(np.diff(values))
-    for k in range(len(steps)):
-        around = np.concatenate([steps[max(0, k - 2):k], steps[k + 1:k + 3]])
-        assert steps[k] <= factor * around.max() + floor, (
-            f"{label}: jump of {steps[k]:.4e} between samples {k} and {k + 1} ({values[k]:.6e} -> "
-            f"{values[k + 1]:.6e}); steps around it {around}")
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
