@@ -3,14 +3,23 @@
 // ray, by the local-moment tail table (docs/spot_table.md). Requires
 // table_texel4(table, x, y) and the helpers of airlight.glsl.
 
-// I(theta) / I0 for cos theta = ct and sin^2 theta = st2, 0 outside the cone.
-// (cos theta - cos A) is computed as (sin^2 A - sin^2 theta) / (cos theta +
-// cos A), without the cancellation of the difference of two cosines.
-float spot_profile(SpotLightGpu s, float ct, float st2) {
+// The profile formula I(theta) / I0 = (1 - q)(cos theta - cos A) / (1 - cos A)
+// + q (MODELS.md section 2) for cos theta = ct and sin^2 theta = st2, the
+// first term clamped at 0. For narrow cones (cos A >= 1/2) the difference of
+// two close cosines is formed as (sin^2 A - sin^2 theta) / (cos theta + cos A)
+// without cancellation; for wide cones ct - cos A is well conditioned against
+// 1 - cos A >= 1/2, and the sine form would be 0/0 along a 90 degree cone's
+// wall (a surface lit by a spot that lies on it).
+float spot_profile_formula(SpotLightGpu s, float ct, float st2) {
     float c = s.axis_cos.w;
-    if (ct < c) return 0.0f;
     float q = s.intensity_edge.w;
-    return max((1.0f - q) * (s.cone.x - st2) / ((ct + c) * s.cone.y), 0.0f) + q;
+    float cos_difference = c >= 0.5f ? (s.cone.x - st2) / (ct + c) : ct - c;
+    return max((1.0f - q) * cos_difference / s.cone.y, 0.0f) + q;
+}
+
+// I(theta) / I0 for cos theta = ct and sin^2 theta = st2, 0 outside the cone.
+float spot_profile(SpotLightGpu s, float ct, float st2) {
+    return ct < s.axis_cos.w ? 0.0f : spot_profile_formula(s, ct, st2);
 }
 
 // I(theta) / I0 in the emission direction `dir` (unit) from the spot.
@@ -154,8 +163,7 @@ float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, OU
     float M2 = 0.5f * N1 * N1 * T.z;
     ct = (tau * r.da - h * r.ma) / dd;
     g = (h * r.da + tau * r.ma) / dd;
-    float q = s.intensity_edge.w;
-    profile = wall ? q : max((1.0f - q) * (s.cone.x - r.na * r.na - g * g) / ((ct + s.axis_cos.w) * s.cone.y), 0.0f) + q;
+    profile = wall ? s.intensity_edge.w : spot_profile_formula(s, ct, r.na * r.na + g * g);
     float beta = s.cone.z;
     magnitude = Q * (abs(profile) + 2.0f * beta * abs(ct) * M2 + beta * abs(g) * M1);
     return Q * (profile - 2.0f * beta * ct * M2 + beta * g * M1);

@@ -49,7 +49,7 @@ from airlight_reference import (
     sphere,
     trace,
 )
-from hypothesis import HealthCheck, given, settings
+from hypothesis import HealthCheck, example, given, settings
 from hypothesis import strategies as st
 from image_checks import finite_non_negative as _finite_non_negative
 from image_checks import no_jumps as _no_jumps
@@ -596,8 +596,24 @@ def spot_scenes(draw):
                       cull_fraction=draw(st.sampled_from([0.0, None])))
 
 
+# Found by CI: the camera and a 5-degree spot on a sphere's surface, the sphere lit by
+# the spot's glow (a 90-degree receiver cone through the spot's centre gave 0/0).
+SPOT_ON_A_SPHERE = {
+    "film": {"width": 24, "height": 16},
+    "camera": {"position": [1.0, 1.0, 0.0], "look_at": [1.0, 1.0, -1.0], "up": [0.0, 1.0, 0.0],
+               "fov_y": 10.0},
+    "lights": [{"type": "spot", "position": [1.0, 1.0, 0.0], "direction": [0.0, 0.0, -1.0], "intensity": 1.0,
+                "cone_angle": 5.0, "edge": 0.0, "radius": 0.96875}],
+    "surfaces": [{"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "albedo": 0.0},
+                 {"type": "sphere", "center": [2.0, 1.0, 0.0], "radius": 1.0, "albedo": 1.0}],
+    "medium": {"sigma_t": 1.0, "albedo": 1.0},
+    "quality": {"cull_fraction": 0.0},
+}
+
+
 @settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(scene=spot_scenes())
+@example(scene=SPOT_ON_A_SPHERE)
 def test_random_spot_scenes_are_finite_and_non_negative(scene):
     """Random valid scenes with spots (any cone angle in (0, 90], q in [0, 1], some around
     the camera, some aimed at it), a point lamp sometimes, fog, surfaces: no NaN, no Inf,

@@ -584,6 +584,8 @@ def road_spot_scenes(draw: Any) -> dict:
         height = side * 10.0 ** draw(st.floats(-3.0, 1.0))
         if abs(height) < 1.5 * radius:
             height = math.copysign(1.5 * radius, height)
+        if draw(st.integers(0, 7)) == 0:  # mounted on the road
+            height = 0.0
         aim = [draw(st.floats(-1, 1)) for _ in range(3)]
         if np.linalg.norm(aim) < 1e-3:
             aim = [0.0, -1.0, 0.0]
@@ -603,7 +605,7 @@ def road_spot_scenes(draw: Any) -> dict:
 @settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(scene=road_spot_scenes())
 def test_random_spots_over_a_road_are_finite_and_non_negative(scene):
-    """Random spots (any cone angle, q, height from 1 mm to 10 m above or below the road,
+    """Random spots (any cone angle, q, height 0 or from 1 mm to 10 m above or below the road,
     any aim, radius 1 mm to 30 cm) over a road in fog: no NaN, no Inf, no negative
     radiance on any available backend."""
     import airlight
@@ -637,6 +639,21 @@ def test_lamp_coming_down_to_the_road(where, backend):
     assert not bad.any(), (f"{where} [{backend}]: heights {heights[bad]}: rendered {g[bad]}, reference "
                            f"{e[bad]} ({(g[bad] / e[bad] - 1)})")
     _no_jumps(np.log(g), f"{where} [{backend}]", floor=1e-3)
+
+
+@pytest.mark.parametrize("backend", BACKENDS)
+@pytest.mark.parametrize("cone_angle,edge", [(30.0, 0.5), (90.0, 0.0), (90.0, 1.0)])
+def test_spot_mounted_on_the_surface_it_lights(cone_angle, edge, backend):
+    """A spot whose centre lies on the road (a lamp set into the ground, aimed up and
+    along it): no direct light on the road, only the glow of the beam above it; a 90-degree
+    cone's wall then runs along the road, where the profile formula was once 0/0 (Inf).
+    Within 0.5 % of the reference."""
+    lamp = spot((0.0, 0.0, 0.0), (1.0, 0.6, 0.2), 200.0, cone_angle, edge, 0.02)
+    scene = make_scene((1.5, 2.0, 3.0), (1.0, 0.0, 0.0), [lamp], [plane((0, 0, 0), (0, 1, 0), 0.5)],
+                       sigma_t=0.2, albedo=1.0, fov_y=60.0, width=120, height=90)
+    samples = road_samples(scene)
+    assert np.allclose(samples.surface, samples.glow, rtol=1e-12, atol=0) and samples.glow.max() > 0
+    check_road(scene, backend, f"spot on the road, A = {cone_angle}, q = {edge}", min_glow=0.3)
 
 
 @pytest.mark.parametrize("backend", BACKENDS)
