@@ -23,12 +23,21 @@ struct CpuShader {
     const SpotLightGpu* spot_lights;
     Features features;
 
+    const float* phase_moment_texels[2];  // per phase lobe (null when unused)
+    const float* phase_glow_texels[2];
+
     float table_texel(int table, int x, int y) const {
-        return table == TABLE_AIRLIGHT_TAIL ? airlight_tail_texels[y * AIRLIGHT_TAIL_NX + x]
-                                            : surface_glow_texels[y * SURFACE_GLOW_NX + x];
+        if (table == TABLE_AIRLIGHT_TAIL) return airlight_tail_texels[y * AIRLIGHT_TAIL_NX + x];
+        const float* glow = table == TABLE_PHASE_GLOW_0   ? phase_glow_texels[0]
+                            : table == TABLE_PHASE_GLOW_1 ? phase_glow_texels[1]
+                                                          : surface_glow_texels;
+        return glow[y * SURFACE_GLOW_NX + x];
     }
-    vec4 table_texel4(int, int x, int y) const {
-        const float* t = spot_moment_texels + (size_t(y) * AIRLIGHT_TAIL_NX + size_t(x)) * 4;
+    vec4 table_texel4(int table, int x, int y) const {
+        const float* texels = table == TABLE_PHASE_MOMENTS_0   ? phase_moment_texels[0]
+                              : table == TABLE_PHASE_MOMENTS_1 ? phase_moment_texels[1]
+                                                               : spot_moment_texels;
+        const float* t = texels + (size_t(y) * AIRLIGHT_TAIL_NX + size_t(x)) * 4;
         return vec4(t[0], t[1], t[2], t[3]);
     }
     int spot_light_count() const { return frame.light_counts.x; }
@@ -47,10 +56,12 @@ struct CpuShader {
 #define GREY_MEDIUM (features.grey_medium)
 #define HAS_SPOT_LIGHTS (features.spot_lights)
 #define HAS_SPOT_AIRLIGHT (features.spot_airlight)
+#define HAS_PHASE (features.phase)
 // The same order as the GLSL source (gl_backend.cpp).
 // clang-format off
 #include "geometry.glsl"
 #include "airlight.glsl"
+#include "phase.glsl"
 #include "spot.glsl"
 #include "shading.glsl"
 // clang-format on
@@ -62,9 +73,14 @@ struct CpuShader {
 #undef GREY_MEDIUM
 #undef HAS_SPOT_LIGHTS
 #undef HAS_SPOT_AIRLIGHT
+#undef HAS_PHASE
 };
 
 }  // namespace shader
+
+namespace {
+const float* texels_of(const Table2D* table) { return table ? table->texels.data() : nullptr; }
+}  // namespace
 
 void CpuBackend::render(const FrameData& data, Image& out) {
     const int width = data.frame.film_counts.x;
@@ -77,11 +93,13 @@ void CpuBackend::render(const FrameData& data, Image& out) {
                                     data.point_lights.data(),
                                     data.surfaces.data(),
                                     data.bvh_nodes.data(),
-                                    data.airlight_tail ? data.airlight_tail->texels.data() : nullptr,
-                                    data.surface_glow ? data.surface_glow->texels.data() : nullptr,
-                                    data.spot_moments ? data.spot_moments->texels.data() : nullptr,
+                                    texels_of(data.airlight_tail),
+                                    texels_of(data.surface_glow),
+                                    texels_of(data.spot_moments),
                                     data.spot_lights.data(),
-                                    data.features};
+                                    data.features,
+                                    {texels_of(data.phase_moments[0]), texels_of(data.phase_moments[1])},
+                                    {texels_of(data.phase_glow[0]), texels_of(data.phase_glow[1])}};
     std::atomic<int> next_row{0};
     auto worker = [&]() {
         shader::CpuShader local = program;

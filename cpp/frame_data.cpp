@@ -55,6 +55,37 @@ void build_bvh(std::vector<BoundedSurface>& items, FrameData& data) {
     build_node(items, 0, int(items.size()), 0, data);
 }
 
+// The lobes of an anisotropic phase function with their weights (none for an
+// isotropic medium, or an HG one with g = 0: the isotropic tables are exact
+// there). |g| is clamped to PHASE_G_LIMIT.
+std::vector<std::pair<PhaseLobe, float>> phase_lobes(const Phase& phase) {
+    auto hg = [](float g) {
+        PhaseLobe l;
+        l.g = std::clamp(g, -shader::PHASE_G_LIMIT, shader::PHASE_G_LIMIT);
+        return l;
+    };
+    std::vector<std::pair<PhaseLobe, float>> lobes;
+    switch (phase.type) {
+        case PhaseType::isotropic:
+            break;
+        case PhaseType::hg:
+            if (phase.g != 0.0f) lobes.push_back({hg(phase.g), 1.0f});
+            break;
+        case PhaseType::rayleigh: {
+            PhaseLobe l;
+            l.rayleigh = true;
+            lobes.push_back({l, 1.0f});
+            break;
+        }
+        case PhaseType::hg2:
+            if (phase.forward_g == 0.0f && phase.backward_g == 0.0f) break;
+            if (phase.forward_weight > 0.0f) lobes.push_back({hg(phase.forward_g), phase.forward_weight});
+            if (phase.forward_weight < 1.0f) lobes.push_back({hg(phase.backward_g), 1.0f - phase.forward_weight});
+            break;
+    }
+    return lobes;
+}
+
 }  // namespace
 
 FrameData make_frame_data(const Scene& scene) {
@@ -166,13 +197,39 @@ FrameData make_frame_data(const Scene& scene) {
     data.features.spot_airlight = scattering && !data.spot_lights.empty();
     data.features.airlight_march =
         (data.features.airlight || data.features.spot_airlight) && scene.quality.airlight == AirlightMethod::march;
-    // The spot table serves the view-ray airlight (unless marched) and the
-    // spots' surface glow.
-    if (data.features.spot_airlight && (!data.features.airlight_march || data.features.surfaces))
-        data.spot_moments = &spot_moment_table();
-    if (data.features.airlight) {
-        data.surface_glow = &surface_glow_table();
-        if (!data.features.airlight_march) data.airlight_tail = &airlight_tail_table();
+    // Which tables the variant reads: the tail (or per-lobe moments) for the
+    // view-ray airlight unless marched, the spot moments also for the spots'
+    // surface glow, the glow table only where surfaces receive it.
+    const bool spot_tables = data.features.spot_airlight && (!data.features.airlight_march || data.features.surfaces);
+    const bool point_tail = data.features.airlight && !data.features.airlight_march;
+    const bool point_glow = data.features.airlight && data.features.surfaces;
+    const auto lobes = scattering ? phase_lobes(scene.medium.phase) : std::vector<std::pair<PhaseLobe, float>>{};
+    data.features.phase = !lobes.empty();
+    f.phase_bounds = glm::vec4(0.5f * shader::PI, shader::SURFACE_GLOW_G_BOUND, 0.0f, 0.0f);
+    f.light_counts.y = int(lobes.size());
+    if (data.features.phase) {
+        double airlight_bound = 0.0, glow_bound = 0.0;
+        for (size_t i = 0; i < lobes.size(); ++i) {
+            const auto& [lobe, weight] = lobes[i];
+            (i == 0 ? f.phase_lobe0 : f.phase_lobe1) = phase_lobe_gpu(lobe, weight);
+            airlight_bound += weight * phase_airlight_bound(lobe);
+            if (spot_tables || point_tail) data.phase_moments[i] = &phase_moment_table(lobe);
+            if (point_glow) data.phase_glow[i] = &phase_glow_table(lobe);
+            // The glow culling bound (a spot's glow is at most a lamp's): the
+            // slice's maximum of G (for g < 0 above the isotropic 8.08: 63 at
+            // g = -0.9); without a slice (spots only) G <= 2 pi^2 int_0^{pi/2} P dt,
+            // from Q_p(u, xi) <= int_xi^{pi/2} P dt and Phi <= 2 pi.
+            const double pi = double(shader::PI);
+            glow_bound +=
+                weight * (data.phase_glow[i] ? std::exp(double(*std::max_element(data.phase_glow[i]->texels.begin(),
+                                                                                 data.phase_glow[i]->texels.end())))
+                                             : 2.0 * pi * pi * phase_airlight_bound(lobe));
+        }
+        f.phase_bounds = glm::vec4(float(airlight_bound * 1.0001), float(glow_bound * 1.001), 0.0f, 0.0f);
+    } else {
+        if (spot_tables) data.spot_moments = &spot_moment_table();
+        if (point_glow) data.surface_glow = &surface_glow_table();
+        if (point_tail) data.airlight_tail = &airlight_tail_table();
     }
     return data;
 }

@@ -21,6 +21,9 @@ struct FrameData {
     const Table2D* airlight_tail = nullptr;
     const Table2D* surface_glow = nullptr;
     const Table2D* spot_moments = nullptr;
+    // Per phase lobe (anisotropic media; docs/phase_table.md).
+    const Table2D* phase_moments[2] = {nullptr, nullptr};
+    const Table2D* phase_glow[2] = {nullptr, nullptr};
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and

@@ -173,7 +173,8 @@ const char* kGlslPrelude =
     "#version 450 core\n"
     "#define CONST const\n"
     "#define OUT(T) out T\n"
-    "#define INOUT(T) inout T\n";
+    "#define INOUT(T) inout T\n"
+    "#define INLINE\n";
 
 }  // namespace
 
@@ -187,8 +188,9 @@ std::string fragment_shader_source(const shader::Features& features) {
     source += std::string("#define GREY_MEDIUM ") + (features.grey_medium ? "true" : "false") + "\n";
     source += std::string("#define HAS_SPOT_LIGHTS ") + (features.spot_lights ? "true" : "false") + "\n";
     source += std::string("#define HAS_SPOT_AIRLIGHT ") + (features.spot_airlight ? "true" : "false") + "\n";
-    for (const char* name : {"constants.glsl", "layout.glsl", "resources.glsl", "geometry.glsl", "airlight.glsl",
-                             "spot.glsl", "shading.glsl", "render.frag"}) {
+    source += std::string("#define HAS_PHASE ") + (features.phase ? "true" : "false") + "\n";
+    for (const char* name : {"constants.glsl", "layout.glsl", "phase_math.glsl", "resources.glsl", "geometry.glsl",
+                             "airlight.glsl", "phase.glsl", "spot.glsl", "shading.glsl", "render.frag"}) {
         source += "// ---- " + std::string(name) + "\n";
         source += shader_source(name);
     }
@@ -318,6 +320,10 @@ void GlBackend::render(const FrameData& data, Image& out) {
     if (data.airlight_tail) glBindTextureUnit(0, s.texture_for(*data.airlight_tail));
     if (data.surface_glow) glBindTextureUnit(1, s.texture_for(*data.surface_glow));
     if (data.spot_moments) glBindTextureUnit(2, s.texture_for(*data.spot_moments));
+    for (int lobe = 0; lobe < 2; ++lobe) {
+        if (data.phase_moments[lobe]) glBindTextureUnit(3 + lobe, s.texture_for(*data.phase_moments[lobe]));
+        if (data.phase_glow[lobe]) glBindTextureUnit(5 + lobe, s.texture_for(*data.phase_glow[lobe]));
+    }
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glDisable(GL_DEPTH_TEST);

@@ -36,7 +36,10 @@ enum class LightType { point, spot };
 template <class E>
 using NameTable = std::vector<std::pair<const char*, E>>;
 
-const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic}};
+const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic},
+                                       {"hg", PhaseType::hg},
+                                       {"rayleigh", PhaseType::rayleigh},
+                                       {"hg2", PhaseType::hg2}};
 const NameTable<LightType> light_types{{"point", LightType::point}, {"spot", LightType::spot}};
 const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic},
                                                  {"march", AirlightMethod::march}};
@@ -294,10 +297,37 @@ Camera parse_camera(const Obj& o) {
     return c;
 }
 
+// A Henyey-Greenstein asymmetry: a number in (-1, 1), also as a float.
+float read_asymmetry(const Value& v) {
+    double g = read_number(v);
+    float f = static_cast<float>(g);
+    if (!(g > -1 && g < 1 && f > -1 && f < 1)) fail(Kind::value, v.field, "must be in (-1, 1)");
+    return f;
+}
+
 Phase parse_phase(const Obj& o) {
-    o.check_keys({"type"});
     Phase p;
     p.type = read_enum(o.req("type"), "phase", phase_types);
+    switch (p.type) {
+        case PhaseType::isotropic:
+        case PhaseType::rayleigh:
+            o.check_keys({"type"});
+            break;
+        case PhaseType::hg:
+            o.check_keys({"type", "g"});
+            p.g = read_asymmetry(o.req("g"));
+            break;
+        case PhaseType::hg2: {
+            o.check_keys({"type", "forward_g", "backward_g", "forward_weight"});
+            p.forward_g = read_asymmetry(o.req("forward_g"));
+            p.backward_g = read_asymmetry(o.req("backward_g"));
+            Value w = o.req("forward_weight");
+            double weight = read_number(w);
+            if (weight < 0 || weight > 1) fail(Kind::value, w.field, "must be in [0, 1]");
+            p.forward_weight = static_cast<float>(weight);
+            break;
+        }
+    }
     return p;
 }
 
@@ -455,6 +485,17 @@ Scene parse_scene_json(const json& j) {
     return s;
 }
 
+json phase_to_json(const Phase& p) {
+    json j = {{"type", name_of(phase_types, p.type)}};
+    if (p.type == PhaseType::hg) j["g"] = json_number(p.g);
+    if (p.type == PhaseType::hg2) {
+        j["forward_g"] = json_number(p.forward_g);
+        j["backward_g"] = json_number(p.backward_g);
+        j["forward_weight"] = json_number(p.forward_weight);
+    }
+    return j;
+}
+
 json scene_to_json_value(const Scene& s) {
     json j;
     j["film"] = {{"width", s.film.width}, {"height", s.film.height}};
@@ -465,7 +506,7 @@ json scene_to_json_value(const Scene& s) {
     if (s.has_medium) {
         j["medium"] = {{"sigma_t", json_vec3(s.medium.sigma_t)},
                        {"albedo", json_vec3(s.medium.albedo)},
-                       {"phase", {{"type", name_of(phase_types, s.medium.phase.type)}}}};
+                       {"phase", phase_to_json(s.medium.phase)}};
     } else {
         j["medium"] = nullptr;
     }

@@ -14,8 +14,11 @@ using namespace glm;
 #define OUT(T) T&
 #define INOUT(T) T&
 
+#define INLINE inline
+
 #include "constants.glsl"
 #include "layout.glsl"
+#include "phase_math.glsl"
 
 // Which optional features a scene uses; a GL shader variant is compiled per
 // combination, the CPU backend branches on them at run time.
@@ -28,10 +31,12 @@ struct Features {
     bool grey_medium = false;     // sigma_t and sigma_s equal on all channels: one evaluation, not three
     bool spot_lights = false;     // spotlights: direct light and cores
     bool spot_airlight = false;   // spotlights in a scattering medium
+    bool phase = false;           // an anisotropic phase function (phase.glsl); else isotropic
 
     int key() const {
         return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |
-               (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0) | (spot_lights ? 64 : 0) | (spot_airlight ? 128 : 0);
+               (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0) | (spot_lights ? 64 : 0) | (spot_airlight ? 128 : 0) |
+               (phase ? 256 : 0);
     }
 };
 

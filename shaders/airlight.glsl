@@ -110,18 +110,20 @@ float airlight_segment(float sigma, float b, float h, float x0, float x1, float 
 // ---- Light scattered onto surfaces ----------------------------------------
 // G(T, theta_s) = e^{T} G0(T, theta_s); the irradiance from light scattered
 // once on the way is sigma_s I / (2 pi D) e^{-T} G (MODELS.md section 1).
-// Row coordinate: Y = (1 + asinh(T c) / asinh(T)) / 2, c = cos theta_s: linear in
-// c for thin media, logarithmic in c for optically distant lights, whose glow
-// turns from lit (c > 0) to unlit (c < 0) over a width ~1/T around c = 0.
+// Row coordinate: Y = (1 + asinh(K c) / asinh(K)) / 2, c = cos theta_s,
+// K = max(T, k_min): linear in c for thin media, logarithmic in c for
+// optically distant lights, whose glow turns from lit (c > 0) to unlit
+// (c < 0) over a width ~1/T around c = 0 (k_min = 1e-4 isotropic; a forward
+// HG lobe's terminator is sharp even in thin fog: k_min = 2 / (1 - g)).
 // log G(T, theta_s) from the table (it stores log G: interpolating the
 // logarithm keeps the relative error even where G varies like log(T) / T).
-float surface_glow_log_lookup(float optical_distance, float cos_theta_s, int nx, int ny) {
+float surface_glow_log_lookup(int table, float k_min, float optical_distance, float cos_theta_s, int nx, int ny) {
     float T = min(optical_distance, SURFACE_GLOW_T_MAX);
     float c = clamp(cos_theta_s, -1.0f, 1.0f);
-    float k = max(T, 1.0e-4f);
+    float k = max(T, k_min);
     float Y = 0.5f + 0.5f * asinh(k * c) / asinh(k);
     float X = sqrt(log(1.0f + T / SURFACE_GLOW_T_SCALE) / log(1.0f + SURFACE_GLOW_T_MAX / SURFACE_GLOW_T_SCALE));
-    return table_bilinear(TABLE_SURFACE_GLOW, nx, ny, X, Y);
+    return table_bilinear(table, nx, ny, X, Y);
 }
 
 // scale e^{-T} G(T, theta_s) = scale G0(T, theta_s), for scale >= 0, as one
@@ -129,6 +131,7 @@ float surface_glow_log_lookup(float optical_distance, float cos_theta_s, int nx,
 // denormal that a GPU flushes to zero (huge intensities at large T).
 float scaled_surface_glow(float scale, float optical_distance, float cos_theta_s) {
     if (scale <= 0.0f) return 0.0f;
-    return exp(surface_glow_log_lookup(optical_distance, cos_theta_s, SURFACE_GLOW_NX, SURFACE_GLOW_NY) -
+    return exp(surface_glow_log_lookup(TABLE_SURFACE_GLOW, SURFACE_GLOW_K_MIN, optical_distance, cos_theta_s,
+                                       SURFACE_GLOW_NX, SURFACE_GLOW_NY) -
                optical_distance + log(scale));
 }

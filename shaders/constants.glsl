@@ -29,9 +29,22 @@ CONST float SURFACE_GLOW_T_SCALE = 0.05f;
 // point lamps' and the spots' glow: G is largest at T = 0, theta_s = 0, where
 // G = pi^2/2 + pi = 8.0762 (tests/cpp/test_tables checks both).
 CONST float SURFACE_GLOW_G_BOUND = 8.08f;
+// The floor of the row warp's scale K = max(T, K_min) (surface_glow_log_lookup).
+CONST float SURFACE_GLOW_K_MIN = 1.0e-4f;
 
 
 // Spot moments (docs/spot_table.md): RGBA texel (S, M1/N1, M2/N2, 0) on the
 // airlight tail's grid, M1 = <sin 2(xi - v)>, M2 = <sin^2(xi - v)> the local
 // moments of the normalised tail weight, N1 = cv/(1 + lam cv/2), N2 = N1^2/2.
 CONST int TABLE_SPOT_MOMENTS = 2;
+
+// Anisotropic phase functions (docs/phase_table.md): per lobe, an RGBA slice
+// (S_p, M1_p/N1_p, M2_p/N2_p, 0) on the airlight tail's size in the lobe's
+// coordinates (phase_math.glsl), and a log G slice of the surface glow's size.
+CONST int TABLE_PHASE_MOMENTS_0 = 3;
+CONST int TABLE_PHASE_MOMENTS_1 = 4;
+CONST int TABLE_PHASE_GLOW_0 = 5;
+CONST int TABLE_PHASE_GLOW_1 = 6;
+// |g| is clamped here for rendering: past it the tables' error grows
+// (1.6e-3 at 0.9999, 6.4e-3 at -0.999; docs/phase_table.md section 0).
+CONST float PHASE_G_LIMIT = 0.999f;

@@ -2,6 +2,12 @@
 // CPU backend (the same structs compiled as C++ against GLM). Only vec4/ivec4
 // members, so std140/std430 and C++ agree byte for byte.
 
+// One lobe of an anisotropic phase function (phase_math.glsl).
+struct PhaseLobeGpu {
+    vec4 shape;  // k = (1 - g) / (1 + g), sqrt k, c = min(k, sqrt k), 1 / (1 - g)
+    vec4 info;   // x: g, y: 1 for Rayleigh, z: glow row-warp floor K_min, w: weight in the mixture
+};
+
 // Per-frame constants (std140 uniform block on the GPU).
 struct FrameUniforms {
     vec4 camera_position;  // xyz: pinhole position
@@ -15,7 +21,10 @@ struct FrameUniforms {
     vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: spot glow samples (spot_surface_glow)
     ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces,
                            // zw: pixel origin of the tile being drawn (GL backend; 0 on the CPU)
-    ivec4 light_counts;    // x: spot lights
+    ivec4 light_counts;    // x: spot lights, y: phase lobes (0: isotropic medium)
+    vec4 phase_bounds;     // x: int_0^{pi/2} P dt (airlight culling; pi/2 isotropic), y: max G (glow culling)
+    PhaseLobeGpu phase_lobe0;
+    PhaseLobeGpu phase_lobe1;
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting

@@ -19,10 +19,20 @@ BvhNodeGpu bvh_node(int i) { return bvh_nodes[i]; }
 layout(binding = 0) uniform sampler2D airlight_tail_texels;
 layout(binding = 1) uniform sampler2D surface_glow_texels;
 layout(binding = 2) uniform sampler2D spot_moment_texels;
+layout(binding = 3) uniform sampler2D phase_moment_texels0;  // per phase lobe (phase.glsl)
+layout(binding = 4) uniform sampler2D phase_moment_texels1;
+layout(binding = 5) uniform sampler2D phase_glow_texels0;
+layout(binding = 6) uniform sampler2D phase_glow_texels1;
 
 float table_texel(int table, int x, int y) {
     if (table == TABLE_AIRLIGHT_TAIL) return texelFetch(airlight_tail_texels, ivec2(x, y), 0).r;
+    if (table == TABLE_PHASE_GLOW_0) return texelFetch(phase_glow_texels0, ivec2(x, y), 0).r;
+    if (table == TABLE_PHASE_GLOW_1) return texelFetch(phase_glow_texels1, ivec2(x, y), 0).r;
     return texelFetch(surface_glow_texels, ivec2(x, y), 0).r;
 }
 
-vec4 table_texel4(int table, int x, int y) { return texelFetch(spot_moment_texels, ivec2(x, y), 0); }
+vec4 table_texel4(int table, int x, int y) {
+    if (table == TABLE_PHASE_MOMENTS_0) return texelFetch(phase_moment_texels0, ivec2(x, y), 0);
+    if (table == TABLE_PHASE_MOMENTS_1) return texelFetch(phase_moment_texels1, ivec2(x, y), 0);
+    return texelFetch(spot_moment_texels, ivec2(x, y), 0);
+}

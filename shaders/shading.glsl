@@ -32,18 +32,18 @@ vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos
     if (GREY_MEDIUM) {
         // sigma equal on all channels: one lookup, the channels differ by I only.
         float peak = max(max(scale.x, scale.y), scale.z);
-        return peak > 0.0f ? (scale / peak) * scaled_surface_glow(peak, sigma_t.x * dist, cos_theta_s) : vec3(0.0f);
+        return peak > 0.0f ? (scale / peak) * medium_surface_glow(peak, sigma_t.x * dist, cos_theta_s) : vec3(0.0f);
     }
-    return vec3(scaled_surface_glow(scale.x, sigma_t.x * dist, cos_theta_s),
-                scaled_surface_glow(scale.y, sigma_t.y * dist, cos_theta_s),
-                scaled_surface_glow(scale.z, sigma_t.z * dist, cos_theta_s));
+    return vec3(medium_surface_glow(scale.x, sigma_t.x * dist, cos_theta_s),
+                medium_surface_glow(scale.y, sigma_t.y * dist, cos_theta_s),
+                medium_surface_glow(scale.z, sigma_t.z * dist, cos_theta_s));
 }
 
 // Upper bound of the once-scattered irradiance from a lamp of intensity I (or
 // a spot of axial intensity I, whose profile is <= 1) at distance dist:
 // sigma_s I e^{-T} G / (2 pi D) with G <= SURFACE_GLOW_G_BOUND, for culling.
 vec3 surface_glow_bound(vec3 intensity, vec3 attenuation, float dist, float radius) {
-    return vec3(frame.sigma_s) * intensity * attenuation * (SURFACE_GLOW_G_BOUND / (2.0f * PI * max(dist, radius)));
+    return vec3(frame.sigma_s) * intensity * attenuation * (frame.phase_bounds.y / (2.0f * PI * max(dist, radius)));
 }
 
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
@@ -125,17 +125,17 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     if (x0 >= x_end) return vec3(0.0f);
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
-    if (negligible(scale * (0.5f * PI) * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
+    if (negligible(scale * frame.phase_bounds.x * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
     if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, origin, dir, x0, x_end);
     // The scale goes into the exponent (airlight_tail); channels without
     // scattering or light have none.
     if (GREY_MEDIUM) {
         float peak = max(max(scale.x, scale.y), scale.z);
-        return peak > 0.0f ? (scale / peak) * airlight_segment(sigma_t.x, b, h, x0, x_end, log(peak)) : vec3(0.0f);
+        return peak > 0.0f ? (scale / peak) * medium_airlight_segment(sigma_t.x, b, h, x0, x_end, log(peak)) : vec3(0.0f);
     }
-    return vec3(scale.x > 0.0f ? airlight_segment(sigma_t.x, b, h, x0, x_end, log(scale.x)) : 0.0f,
-                scale.y > 0.0f ? airlight_segment(sigma_t.y, b, h, x0, x_end, log(scale.y)) : 0.0f,
-                scale.z > 0.0f ? airlight_segment(sigma_t.z, b, h, x0, x_end, log(scale.z)) : 0.0f);
+    return vec3(scale.x > 0.0f ? medium_airlight_segment(sigma_t.x, b, h, x0, x_end, log(scale.x)) : 0.0f,
+                scale.y > 0.0f ? medium_airlight_segment(sigma_t.y, b, h, x0, x_end, log(scale.y)) : 0.0f,
+                scale.z > 0.0f ? medium_airlight_segment(sigma_t.z, b, h, x0, x_end, log(scale.z)) : 0.0f);
 }
 
 // Radiance arriving at the camera along the ray origin + t dir.

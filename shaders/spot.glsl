@@ -144,23 +144,38 @@ bool spot_lit_interval(SpotLightGpu s, SpotRay r, float tau_start, float tau_end
 
 // The spot tail at tau, per unit I0 and in units of sigma_s I0 / (2 pi h)
 // exp(-sigma (x + d)): Q (I_v - 2 beta cos(theta_v) M2 + beta g_v M1), and the
-// sum of the magnitudes of its terms (for the cancellation test).
-float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, OUT(float) magnitude,
+// sum of the magnitudes of its terms (for the cancellation test). Q, M1 and M2
+// are those of the isotropic medium (lobe < 0), or of phase lobe `lobe`, whose
+// moments are taken under its phase-weighted tail (docs/phase_table.md
+// section 7: the identity holds for any phase function).
+float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, int lobe, OUT(float) magnitude,
                 OUT(float) ct, OUT(float) g, OUT(float) profile) {
     float h = r.h;
-    float dd = sqrt(h * h + tau * tau);
-    float p = tau >= 0.0f ? dd + tau : h * h / (dd - tau);  // d + x - b
-    float t = p / h;
-    float cv = 0.5f * atan(h, tau);
-    float z = min(sigma * sqrt(2.0f * dd * p), 1.0e20f);
-    float lam = 2.0f * sigma * dd * t;
-    vec4 T = table_bilinear4(TABLE_SPOT_MOMENTS, AIRLIGHT_TAIL_NX, AIRLIGHT_TAIL_NY, sqrt(z / (1.0f + z)),
-                             1.0f - cv * (2.0f / PI));
-    float N = cv / (1.0f + lam * cv);
-    float N1 = cv / (1.0f + 0.5f * lam * cv);
-    float Q = N * T.x;
-    float M1 = N1 * T.y;
-    float M2 = 0.5f * N1 * N1 * T.z;
+    float dd;
+    float Q;
+    float M1;
+    float M2;
+    if (lobe >= 0) {
+        LobeEnd e = lobe_end(lobe, sigma, h, tau);
+        dd = e.d;
+        Q = e.N * e.texel.x;
+        M1 = e.N1 * e.texel.y;
+        M2 = 0.5f * e.N1 * e.N1 * e.texel.z;
+    } else {
+        dd = sqrt(h * h + tau * tau);
+        float p = tau >= 0.0f ? dd + tau : h * h / (dd - tau);  // d + x - b
+        float t = p / h;
+        float cv = 0.5f * atan(h, tau);
+        float z = min(sigma * sqrt(2.0f * dd * p), 1.0e20f);
+        float lam = 2.0f * sigma * dd * t;
+        vec4 T = table_bilinear4(TABLE_SPOT_MOMENTS, AIRLIGHT_TAIL_NX, AIRLIGHT_TAIL_NY, sqrt(z / (1.0f + z)),
+                                 1.0f - cv * (2.0f / PI));
+        float N = cv / (1.0f + lam * cv);
+        float N1 = cv / (1.0f + 0.5f * lam * cv);
+        Q = N * T.x;
+        M1 = N1 * T.y;
+        M2 = 0.5f * N1 * N1 * T.z;
+    }
     ct = (tau * r.da - h * r.ma) / dd;
     g = (h * r.da + tau * r.ma) / dd;
     profile = wall ? s.intensity_edge.w : spot_profile_formula(s, ct, r.na * r.na + g * g);
@@ -169,19 +184,53 @@ float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, OU
     return Q * (profile - 2.0f * beta * ct * M2 + beta * g * M1);
 }
 
+// The fallback of spot_lobe_airlight for phase lobe `lobe`: 4-point
+// Gauss-Legendre in phi over [phi(lo), phi(hi)] of rho(phi)
+// exp(-u k (tan phi - tan phi0)) times the profile's local expansion about lo
+// at Delta = xi - xi0, tan xi = k tan phi (docs/phase_table.md section 7).
+// length_lit = hi - lo, formed by the caller without cancellation.
+float spot_lobe_quadrature(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, float length_lit, int lobe,
+                           float profile0, float ct0, float g0) {
+    PhaseLobeGpu l = phase_lobe(lobe);
+    float k = l.shape.x;
+    float h = r.h;
+    LobeEnd e0 = lobe_end(lobe, sigma, h, lo);
+    float dphi = e0.cvp;
+    if (hi < NO_HIT) dphi = lobe_angle_between(lobe, h, e0, lobe_end(lobe, sigma, h, hi), length_lit);
+    float uk = sigma * h * k;
+    float s0 = sin(e0.cvp);
+    float c0 = cos(e0.cvp);
+    float beta = s.cone.z;
+    float J = 0.0f;
+    for (int j = 0; j < 4; ++j) {
+        float D = 0.5f * dphi * (1.0f + gauss4_node(j));
+        float c1 = e0.cvp - D;
+        if (!(c1 > 0.0f)) continue;
+        float s1 = sin(c1);
+        // tan(xi) = k tan(phi): Delta = xi - xi0 from phi - phi0 = D
+        float delta = atan(k * sin(D), s1 * s0 + k * k * cos(c1) * c0);
+        float sd = sin(delta);
+        float I = max(profile0 - 2.0f * beta * ct0 * sd * sd + beta * g0 * sin(2.0f * delta), 0.0f);
+        J += 0.5f * gauss4_weight(j) * I * lobe_density(l, c1) * exp(-uk * sin(D) / (s0 * s1));
+    }
+    return J * dphi;
+}
+
 // Airlight of a spot over its lit interval [lo, hi] of the view ray, one
-// channel: scale exp(-sigma (x_lo + d_lo)) J (docs/spot_table.md section 3),
-// scale = sigma_s I0 / (2 pi h) > 0 folded into the exponent. J is the
-// difference of two spot tails, or, where that difference would amplify the
-// table error more than 4 times, 4-point Gauss-Legendre in xi on the exact
-// integrand written about lo.
-float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, bool wall_lo, bool wall_hi,
-                            float clip_length, float scale) {
+// channel and one phase lobe (lobe < 0: isotropic medium): scale
+// exp(-sigma (x_lo + d_lo)) J (docs/spot_table.md section 3), scale =
+// sigma_s I0 / (2 pi h) > 0 folded into the exponent. J is the difference of
+// two spot tails, or, where that difference would amplify the table error
+// more than 4 times, 4-point Gauss-Legendre on the exact integrand written
+// about lo: in xi when isotropic, in the lobe's phi (docs/phase_table.md
+// section 7) otherwise.
+float spot_lobe_airlight(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, bool wall_lo, bool wall_hi,
+                         float clip_length, int lobe, float scale) {
     float mag0;
     float ct0;
     float g0;
     float profile0;
-    float tail0 = spot_tail(s, r, sigma, lo, wall_lo, mag0, ct0, g0, profile0);
+    float tail0 = spot_tail(s, r, sigma, lo, wall_lo, lobe, mag0, ct0, g0, profile0);
     float arg0 = -sigma * (r.b + lo + sqrt(r.h * r.h + lo * lo));
     bool escapes = hi >= NO_HIT;
     float J = tail0;
@@ -191,13 +240,16 @@ float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, fl
         float ct1;
         float g1;
         float profile1;
-        float tail1 = spot_tail(s, r, sigma, hi, wall_hi, mag1, ct1, g1, profile1);
+        float tail1 = spot_tail(s, r, sigma, hi, wall_hi, lobe, mag1, ct1, g1, profile1);
         float arg1 = -sigma * (r.b + hi + sqrt(r.h * r.h + hi * hi));
         float ratio = exp(arg1 - arg0);
         J = tail0 - ratio * tail1;
         mag = mag0 + ratio * mag1;
     }
-    if (!(mag <= 4.0f * abs(J))) {
+    if (!(mag <= 4.0f * abs(J)) && lobe >= 0) {
+        J = spot_lobe_quadrature(s, r, sigma, lo, hi, wall_lo || wall_hi ? hi - lo : clip_length, lobe, profile0, ct0,
+                                 g0);
+    } else if (!(mag <= 4.0f * abs(J))) {
         float h = r.h;
         float cv0 = 0.5f * atan(h, lo);
         float length_lit = (wall_lo || wall_hi) ? hi - lo : clip_length;
@@ -216,6 +268,19 @@ float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, fl
         J *= dv;
     }
     return max(J, 0.0f) * exp(arg0 + log(scale));
+}
+
+// spot_lobe_airlight for the medium's phase function: isotropic, or the
+// weighted sum over its lobes.
+float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, bool wall_lo, bool wall_hi,
+                            float clip_length, float scale) {
+    if (!HAS_PHASE) return spot_lobe_airlight(s, r, sigma, lo, hi, wall_lo, wall_hi, clip_length, -1, scale);
+    float sum = 0.0f;
+    for (int lobe = 0; lobe < phase_lobe_count(); ++lobe) {
+        float w = phase_lobe(lobe).info.w;
+        if (w > 0.0f) sum += spot_lobe_airlight(s, r, sigma, lo, hi, wall_lo, wall_hi, clip_length, lobe, scale * w);
+    }
+    return sum;
 }
 
 // Brute-force airlight of a point light, or of spot number spot_index (>= 0),
@@ -237,7 +302,7 @@ vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, vec3 or
         float d2 = dot(from_light, from_light);
         float d = sqrt(d2);
         float profile = spot ? spot_profile_toward(s, from_light / d) : 1.0f;
-        sum += profile * exp(-sigma_t * (x + d)) / d2;
+        sum += profile * medium_phase(-dot(from_light, dir) / d) * exp(-sigma_t * (x + d)) / d2;
     }
     return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
 }
@@ -259,7 +324,7 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(s.intensity_edge) / (2.0f * PI * r.h);
     float min_sigma_t = min(min(sigma_t.x, sigma_t.y), sigma_t.z);
-    if (negligible(scale * ((0.5f * PI) * exp(-min_sigma_t * max(dist - radius, 0.0f))), so_far)) return vec3(0.0f);
+    if (negligible(scale * (frame.phase_bounds.x * exp(-min_sigma_t * max(dist - radius, 0.0f))), so_far)) return vec3(0.0f);
     float lo;
     float hi;
     bool wall_lo;

@@ -25,10 +25,22 @@ struct Camera {
     float fov_y_degrees = 60.0f;
 };
 
-enum class PhaseType { isotropic };
+enum class PhaseType { isotropic, hg, rayleigh, hg2 };
 
+// The medium's phase function p(cos theta), normalised to 1 over the sphere,
+// theta the angle between the light's directions before and after scattering
+// (MODELS.md conventions):
+//   isotropic  1 / (4 pi)
+//   hg         Henyey-Greenstein with asymmetry g in (-1, 1)
+//   rayleigh   3 / (16 pi) (1 + cos^2 theta)
+//   hg2        forward_weight HG(forward_g) + (1 - forward_weight) HG(backward_g)
+// Rendering clamps |g| to PHASE_G_LIMIT (docs/phase_table.md, section 0).
 struct Phase {
     PhaseType type = PhaseType::isotropic;
+    float g = 0.0f;               // hg
+    float forward_g = 0.0f;       // hg2
+    float backward_g = 0.0f;      // hg2
+    float forward_weight = 1.0f;  // hg2
 };
 
 // Homogeneous participating medium filling all space (MODELS.md conventions):

@@ -115,7 +115,8 @@ double glow_table_error(const Table2D& table, int samples, std::mt19937& rng, do
         const double exact = surface_glow_exact(T, theta);
         if (exact < 1e-6 * g00) continue;
         const float G =
-            std::exp(sampler.surface_glow_log_lookup(float(T), float(std::cos(theta)), table.width, table.height));
+            std::exp(sampler.surface_glow_log_lookup(shader::TABLE_SURFACE_GLOW, shader::SURFACE_GLOW_K_MIN, float(T),
+                                                     float(std::cos(theta)), table.width, table.height));
         worst = std::max(worst, std::abs(G / exact - 1.0));
     }
     return worst;

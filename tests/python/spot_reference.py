@@ -114,10 +114,108 @@ class Spot:
     edge: float  # q
 
 
+# ---- phase functions -----------------------------------------------------------------------------
+
+HG_G_LIMIT = 0.999  # the renderer clamps |g| to this (scene format: g in (-1, 1))
+
+
+def _hg(g: float, cos_t: Any) -> Any:
+    """4 pi p_HG(cos theta) = (1 - g^2) / (1 + g^2 - 2 g cos theta)^1.5 (float or array)."""
+    if isinstance(cos_t, float):
+        return (1.0 - g * g) / (1.0 + g * g - 2.0 * g * cos_t) ** 1.5
+    cos_t = np.asarray(cos_t, dtype=np.float64)
+    return (1.0 - g * g) / (1.0 + g * g - 2.0 * g * cos_t) ** 1.5
+
+
+@dataclass(frozen=True)
+class Phase:
+    """A phase function as 4 pi p(cos theta) (so isotropic is 1), theta the angle between the
+    light's propagation directions before and after scattering (0: forward). Frozen, so it
+    can key caches. Any callable taking cos theta (float or array) and returning 4 pi p can
+    be used wherever a phase is accepted; an optional ``peaks`` attribute (as here) names
+    narrow lobes so that the quadratures put break points at their scale.
+
+    kind "isotropic"; "hg": Henyey-Greenstein with g; "rayleigh": 3/4 (1 + cos^2 theta);
+    "hg2": weight HG(g) + (1 - weight) HG(g2)."""
+
+    kind: str = "isotropic"
+    g: float = 0.0
+    g2: float = 0.0
+    weight: float = 1.0
+
+    def __call__(self, cos_t: Any) -> Any:
+        if self.kind == "hg":
+            return _hg(self.g, cos_t)
+        if self.kind == "hg2":
+            return self.weight * _hg(self.g, cos_t) + (1.0 - self.weight) * _hg(self.g2, cos_t)
+        if self.kind == "rayleigh":
+            if isinstance(cos_t, float):
+                return 0.75 * (1.0 + cos_t * cos_t)
+            cos_t = np.asarray(cos_t, dtype=np.float64)
+            return 0.75 * (1.0 + cos_t * cos_t)
+        if self.kind == "isotropic":
+            return 1.0 if isinstance(cos_t, float) else np.ones_like(np.asarray(cos_t, dtype=np.float64))
+        raise ValueError(f"unknown phase kind {self.kind!r}")
+
+    @property
+    def peaks(self) -> tuple[tuple[float, float], ...]:
+        """Narrow lobes as (+1 forward | -1 backward, angular width ~ 1 - |g|): HG lobes with
+        |g| >= 0.5 (wider ones need no break points)."""
+        lobes = {"hg": [(self.g, 1.0)], "hg2": [(self.g, self.weight), (self.g2, 1.0 - self.weight)]}
+        out = []
+        for g, w in lobes.get(self.kind, []):
+            if abs(g) >= 0.5 and w != 0.0:
+                out.append((1.0 if g > 0 else -1.0, 1.0 - abs(g)))
+        return tuple(out)
+
+
+ISOTROPIC = Phase()
+
+
+def is_isotropic(phase: Any) -> bool:
+    """True for None (the default everywhere) and the isotropic Phase."""
+    return phase is None or (isinstance(phase, Phase) and phase.kind == "isotropic")
+
+
+def phase_peaks(phase: Any) -> tuple[tuple[float, float], ...]:
+    return tuple(getattr(phase, "peaks", ())) if phase is not None else ()
+
+
+def parse_phase(value: Any) -> Phase:
+    """medium.phase of a scene dict (absent or None: isotropic); |g| clamped to HG_G_LIMIT
+    as the renderer does."""
+    if value is None:
+        return ISOTROPIC
+    kind = value.get("type", "isotropic")
+
+    def g_of(key: str) -> float:
+        return float(np.clip(float(value[key]), -HG_G_LIMIT, HG_G_LIMIT))
+
+    if kind == "isotropic":
+        return ISOTROPIC
+    if kind == "hg":
+        return Phase("hg", g_of("g"))
+    if kind == "rayleigh":
+        return Phase("rayleigh")
+    if kind == "hg2":
+        return Phase("hg2", g_of("forward_g"), g_of("backward_g"), float(value["forward_weight"]))
+    raise ValueError(f"spot_reference: unknown phase type {kind!r}")
+
+
+def phase_dict(phase: Phase) -> dict[str, Any]:
+    """The scene format's medium.phase for a Phase."""
+    if phase.kind == "hg":
+        return {"type": "hg", "g": phase.g}
+    if phase.kind == "hg2":
+        return {"type": "hg2", "forward_g": phase.g, "backward_g": phase.g2, "forward_weight": phase.weight}
+    return {"type": phase.kind}
+
+
 @dataclass
 class SpotScene:
     sc: Scene  # every light (points and spots) as an airlight_reference.Light
     spots: list[Spot | None]  # per light: None for a point light
+    phase: Any = None  # the medium's phase (None: isotropic); see Phase
 
     @property
     def point_indices(self) -> list[int]:
@@ -155,7 +253,9 @@ def parse_spot_scene(scene: Any) -> SpotScene:
         else:
             raise ValueError(f"spot_reference: unknown light type {kind!r}")
     # airlight_reference.parse_scene reads position, intensity and radius of any light
-    return SpotScene(parse_scene(scene), spots)
+    medium = scene.get("medium")
+    phase = parse_phase(medium.get("phase") if isinstance(medium, Mapping) else None)
+    return SpotScene(parse_scene(scene), spots, None if is_isotropic(phase) else phase)
 
 
 def profile(cos_theta: Any, spot: Spot) -> np.ndarray:
@@ -294,8 +394,10 @@ def _psi_pieces(b: float, h: float, lo: float, hi: float) -> list[tuple[str, flo
 
 
 def _spot_unit_log(sigma: float, b: float, h: float, da: float, ma: float, cos_a: float, edge: float,
-                   lo: float, hi: float) -> float:
-    """log of int_lo^hi (I / I0) exp(-sigma (x + |S - p|)) / |S - p|^2 dx (-inf when 0)."""
+                   lo: float, hi: float, phase: Any = None) -> float:
+    """log of int_lo^hi (I / I0) P exp(-sigma (x + |S - p|)) / |S - p|^2 dx (-inf when 0), with
+    P = 4 pi p(cos theta) the phase (1 when None), cos theta = ((p - S)/|p - S|).(-d) =
+    cos(psi) = -cos(chi): psi is the scattering angle itself."""
     if not hi > lo:
         return -math.inf
     h = max(h, 1e-280)  # a ray through the centre: the same integral to 1e-280 m
@@ -309,14 +411,17 @@ def _spot_unit_log(sigma: float, b: float, h: float, da: float, ma: float, cos_a
 
     def f_psi(psi: float) -> float:
         cos_t = -math.cos(psi) * da - math.sin(psi) * ma
-        return prof(cos_t) * math.exp(-sigma * h * (math.tan(0.5 * psi) - t_lo))
+        value = prof(cos_t) * math.exp(-sigma * h * (math.tan(0.5 * psi) - t_lo))
+        return value if phase is None else value * phase(math.cos(psi))
 
     def f_chi(chi: float) -> float:
         cos_t = math.cos(chi) * da - math.sin(chi) * ma
         half = math.tan(0.5 * chi)
         if half <= 0.0:
-            return 0.0 if sigma > 0 else prof(cos_t)
-        return prof(cos_t) * math.exp(-sigma * h * (1.0 / half - t_lo))
+            value = 0.0 if sigma > 0 else prof(cos_t)
+        else:
+            value = prof(cos_t) * math.exp(-sigma * h * (1.0 / half - t_lo))
+        return value if phase is None else value * phase(-math.cos(chi))
 
     total = err = 0.0
     with warnings.catch_warnings():
@@ -327,6 +432,9 @@ def _spot_unit_log(sigma: float, b: float, h: float, da: float, ma: float, cos_a
                 for k in range(-2, 5):
                     tk = t_lo + 10.0 ** k / (sigma * h)
                     breaks.add(2.0 * math.atan(tk) if kind == "psi" else 2.0 * math.atan2(1.0, tk))
+            for side, width in phase_peaks(phase):  # a narrow lobe at psi = 0 (forward) or chi = 0
+                if (side > 0) == (kind == "psi"):
+                    breaks.update(width * f for f in (0.125, 0.5, 2.0, 8.0))
             edges = [a] + sorted(p for p in breaks if a < p < c) + [c]
             fun = f_psi if kind == "psi" else f_chi
             for p0, p1 in zip(edges[:-1], edges[1:]):
@@ -346,9 +454,12 @@ def _spot_unit_log_cached(*args: float) -> float:
 
 
 def spot_unit_logs(sigma_t: float, origin: Sequence[float], dirs: np.ndarray, position: Sequence[float],
-                   spot: Spot, x0: Any = 0.0, x1: Any = math.inf) -> np.ndarray:
-    """Per ray (N,): log of int (I / I0) exp(-sigma_t (x + |S - p|)) / |S - p|^2 dx over the
-    lit part of [x0, x1] (-inf when none); the lit intervals are found for all rays at once."""
+                   spot: Spot, x0: Any = 0.0, x1: Any = math.inf, phase: Any = None) -> np.ndarray:
+    """Per ray (N,): log of int (I / I0) P exp(-sigma_t (x + |S - p|)) / |S - p|^2 dx over the
+    lit part of [x0, x1] (-inf when none); the lit intervals are found for all rays at once.
+    P = 4 pi p(cos theta) is the phase (a Phase or any callable of cos theta; None or
+    isotropic: 1), theta between the light's direction (p - S)/|p - S| and -d."""
+    phase = None if is_isotropic(phase) else phase
     dirs = np.atleast_2d(np.asarray(dirs, dtype=np.float64))
     origin = np.asarray(origin, dtype=np.float64)
     position = np.asarray(position, dtype=np.float64)
@@ -357,34 +468,38 @@ def spot_unit_logs(sigma_t: float, origin: Sequence[float], dirs: np.ndarray, po
     out = np.full(len(dirs), -math.inf)
     for k in np.nonzero(meets)[0]:
         out[k] = _spot_unit_log_cached(float(sigma_t), float(fr.b[k]), float(fr.h[k]), float(fr.da[k]),
-                                       float(fr.ma[k]), spot.cos_a, spot.edge, float(lo[k]), float(hi[k]))
+                                       float(fr.ma[k]), spot.cos_a, spot.edge, float(lo[k]), float(hi[k]),
+                                       phase)
     return out
 
 
 def spot_airlight_log(sigma_t: float, sigma_s: float, intensity: float, origin: Sequence[float],
                       direction: Sequence[float], position: Sequence[float], spot: Spot, x0: float = 0.0,
-                      x1: float = math.inf) -> float:
+                      x1: float = math.inf, phase: Any = None) -> float:
     """log of the airlight (one channel, W/(m^2 sr)) of a spot (axial intensity
-    `intensity`) over [x0, x1] of the ray origin + x direction (unit); -inf when 0."""
+    `intensity`) over [x0, x1] of the ray origin + x direction (unit); -inf when 0.
+    `phase`: see :func:`spot_unit_logs` (default isotropic)."""
     if sigma_s <= 0 or intensity <= 0 or not x1 > x0:
         return -math.inf
     dirs = np.asarray(direction, dtype=np.float64)[None, :]
-    unit = spot_unit_logs(sigma_t, origin, dirs, position, spot, x0, x1)[0]
+    unit = spot_unit_logs(sigma_t, origin, dirs, position, spot, x0, x1, phase)[0]
     return math.log(sigma_s * intensity / (4.0 * math.pi)) + unit
 
 
 def spot_airlight(sigma_t: float, sigma_s: float, intensity: float, origin: Sequence[float],
                   direction: Sequence[float], position: Sequence[float], spot: Spot, x0: float = 0.0,
-                  x1: float = math.inf) -> float:
+                  x1: float = math.inf, phase: Any = None) -> float:
     """The airlight of :func:`spot_airlight_log`; 0 where it underflows float64."""
-    return math.exp(spot_airlight_log(sigma_t, sigma_s, intensity, origin, direction, position, spot, x0, x1))
+    return math.exp(spot_airlight_log(sigma_t, sigma_s, intensity, origin, direction, position, spot, x0, x1,
+                                      phase))
 
 
 def spot_airlight_riemann(sigma_t: float, sigma_s: float, intensity: float, origin: Sequence[float],
                           direction: Sequence[float], position: Sequence[float], spot: Spot, x0: float,
-                          x1: float, n: int = 2_000_000) -> float:
+                          x1: float, n: int = 2_000_000, phase: Any = None) -> float:
     """Brute force for checking: the midpoint rule with n points in x on [x0, x1] (finite)
-    of the defining integrand, the cone tested at every point (no lit interval)."""
+    of the defining integrand, the cone tested at every point (no lit interval); `phase`
+    (4 pi p) evaluated at cos theta = -((p - S)/|p - S|).d."""
     origin = np.asarray(origin, dtype=np.float64)
     direction = np.asarray(direction, dtype=np.float64)
     position = np.asarray(position, dtype=np.float64)
@@ -395,6 +510,8 @@ def spot_airlight_riemann(sigma_t: float, sigma_s: float, intensity: float, orig
         rel = origin[None, :] + x[:, None] * direction[None, :] - position[None, :]
         dist = np.linalg.norm(rel, axis=1)
         weight = profile((rel @ spot.axis) / dist, spot)
+        if not is_isotropic(phase):
+            weight = weight * phase(-(rel @ direction) / dist)
         total += float(np.sum(weight * np.exp(-sigma_t * (x + dist)) / dist ** 2))
     return sigma_s * intensity / (4.0 * math.pi) * total * dx
 
@@ -513,8 +630,8 @@ def _tangent_azimuths(fr: GlowFrame) -> list[float]:
     return [fr.beta_a + s for s in (d, -d, math.pi - d, math.pi + d)]
 
 
-def _alpha_breaks(fr: GlowFrame, sigma: float, normal: np.ndarray,
-                  axis: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _alpha_breaks(fr: GlowFrame, sigma: float, normal: np.ndarray, axis: np.ndarray,
+                  phase: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """Break points in alpha (sorted) and their kinds: the hemisphere's extent, where the
     horizon's circle and the cone's circle of directions enter or leave the alpha circles,
     where they cross each other and the tangent great circles, the tangent points, and, in
@@ -541,6 +658,9 @@ def _alpha_breaks(fr: GlowFrame, sigma: float, normal: np.ndarray,
                 cand.append((math.acos(float(np.clip(w @ fr.u, -1.0, 1.0))), _FINE))
     if a_min == 0.0 and sigma * fr.dist > 1.0:
         cand += [(4.0 ** k / (sigma * fr.dist), _PLAIN) for k in (-2, -1, 0, 1)]
+    for side, width in phase_peaks(phase):  # the scattering angle alpha + psi is >= alpha: a
+        for f in (0.125, 0.5, 2.0, 8.0):  # forward lobe shapes small alpha, a backward one alpha near pi
+            cand.append((width * f if side > 0 else math.pi - width * f, _PLAIN))
     points = {a_min: _FINE if a_min == 0.0 else _SMOOTH, a_max: _SMOOTH}
     for value, kind in cand:
         if a_min < value < a_max:
@@ -601,11 +721,14 @@ def _beta_breaks(fr: GlowFrame, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarr
 
 
 def glow_ray_units(fr: GlowFrame, sigma: float, alpha: np.ndarray, beta: np.ndarray,
-                   nodes: int = GLOW_NODES[2]) -> np.ndarray:
-    """Per direction (alpha, beta) from P: J = int (I / I0) exp(-x) dpsi over the lit part of
+                   nodes: int = GLOW_NODES[2], phase: Any = None) -> np.ndarray:
+    """Per direction (alpha, beta) from P: J = int (I / I0) P exp(-x) dpsi over the lit part of
     the ray, psi the angle at S between S->P and S->y (0 at P, pi - alpha at infinity) and
     x = sigma (t + |y - S| - D); the airlight of the spot along the ray from P is then
     sigma_s I0 / (4 pi) exp(-sigma D) / (D sin alpha) J (dt / |y - S|^2 = dpsi / (D sin alpha)).
+    P = 4 pi p(cos theta) is the phase (None: 1) for light going S -> y -> P: theta is the
+    angle between y - S and P - y, cos theta = cos(alpha + psi) = -cos(z) below (forward
+    only for y on the segment from S to P).
     The emission direction is -cos(psi) u + sin(psi) v, v = cos(beta) e1 + sin(beta) e2, so
     a.(y - S)/|y - S| = R cos(psi - phi) with R, phi closed forms of beta: the lit part of
     the ray is an exact arc. Pieces end where x rises by _GLOW_RAY_LEVELS; towards
@@ -639,6 +762,9 @@ def glow_ray_units(fr: GlowFrame, sigma: float, alpha: np.ndarray, beta: np.ndar
                 zk = 2.0 * np.arctan2(1.0, np.tan(half) + (x_lo + level) / scale)  # x(z) = x_lo + level
                 zs.append(np.where(np.isfinite(zk), zk, 0.0))
         z_cut = zs.pop()
+    for side, width in phase_peaks(phase):  # z = pi - (scattering angle): a lobe's scale
+        for f in (0.125, 0.5, 2.0, 8.0):
+            zs.append(np.full(len(idx), math.pi - width * f if side > 0 else width * f))
     z_end = np.maximum(z_hi, z_cut)
     zz = np.clip(np.stack(zs + [z_end], axis=1), z_end[:, None], z_lo[:, None])
     zz = -np.sort(-zz, axis=1)  # decreasing: from the lit start towards infinity
@@ -657,17 +783,21 @@ def glow_ray_units(fr: GlowFrame, sigma: float, alpha: np.ndarray, beta: np.ndar
     cos_t = r[rows, None] * np.cos(end[rows, None] - z - phi[rows, None])
     prof = np.maximum((1.0 - fr.edge) * (cos_t - fr.cos_a) / (1.0 - fr.cos_a) + fr.edge, 0.0)
     x = k[rows, None] * np.cos(0.5 * (al[rows, None] + z)) / np.sin(0.5 * z)
+    if phase is not None:
+        prof = prof * phase(-np.cos(z))
     values = (width * tw * prof * np.exp(-x)).sum(axis=1)
     out[idx] = np.bincount(rows, weights=values, minlength=len(idx))
     return out
 
 
 def spot_glow_unit(sigma_t: float, position: Any, spot: Spot, point: Any, normal: Any,
-                   nodes: tuple[int, int, int] = GLOW_NODES) -> float:
+                   nodes: tuple[int, int, int] = GLOW_NODES, phase: Any = None) -> float:
     """The glow of a spot at a surface point per unit sigma_s I0 / (4 pi):
-    ``int over the hemisphere n.w > 0 of (n.w) int_0^inf (I / I0) exp(-sigma_t (t + |y - S|))
+    ``int over the hemisphere n.w > 0 of (n.w) int_0^inf (I / I0) P exp(-sigma_t (t + |y - S|))
     / |y - S|^2 dt dw``, y = P + t w, i.e. the volume integral of MODELS.md's glow with the
-    medium filling all space (nothing occludes, the lamp's sphere included).
+    medium filling all space (nothing occludes, the lamp's sphere included). P = 4 pi p(cos
+    theta), theta between y - S and P - y, is the phase (None or isotropic: 1; a Phase or a
+    hashable callable of cos theta).
 
     In polar coordinates (alpha, beta) about the direction u from P to S (so the 1/alpha
     peak of the airlight of rays passing S meets the Jacobian sin(alpha)), innermost the
@@ -676,19 +806,20 @@ def spot_glow_unit(sigma_t: float, position: Any, spot: Spot, point: Any, normal
     piece halved and each half mapped by smoothstep (algebraic end points), an exponential
     grading (layers, nearby complex singularities) or nothing."""
     key = (float(sigma_t), tuple(float(v) for v in position), tuple(float(v) for v in spot.axis), spot.cos_a,
-           spot.edge, tuple(float(v) for v in point), tuple(float(v) for v in normal), tuple(nodes))
+           spot.edge, tuple(float(v) for v in point), tuple(float(v) for v in normal), tuple(nodes),
+           None if is_isotropic(phase) else phase)
     return _spot_glow_unit_cached(key)
 
 
 @functools.lru_cache(maxsize=20_000)
 def _spot_glow_unit_cached(key: tuple) -> float:
-    sigma, position, axis, cos_a, edge, point, normal, nodes = key
+    sigma, position, axis, cos_a, edge, point, normal, nodes, phase = key
     n_alpha, n_beta, n_ray = nodes
     sp = Spot(np.array(axis), math.degrees(math.acos(cos_a)), cos_a, edge)
     fr = glow_frame(position, sp, point, normal)
     n = np.asarray(normal, dtype=np.float64)
     n = n / np.linalg.norm(n)
-    edges, kinds = _alpha_breaks(fr, sigma, n, np.asarray(axis))
+    edges, kinds = _alpha_breaks(fr, sigma, n, np.asarray(axis), phase)
     alpha, w_alpha = (v.ravel() for v in _piece_rule(edges, kinds, n_alpha))
     br, kd = _beta_breaks(fr, alpha)
     beta, w_beta = _piece_rule(br, kd, n_beta)
@@ -698,23 +829,25 @@ def _spot_glow_unit_cached(key: tuple) -> float:
     beta = beta.ravel()
     cos_n = np.cos(alpha) * fr.cos_s + np.sin(alpha) * fr.sin_s * np.cos(beta)  # n.w
     keep = (weight > 0) & (cos_n > 0)
-    units = glow_ray_units(fr, sigma, alpha[keep], beta[keep], n_ray)
+    units = glow_ray_units(fr, sigma, alpha[keep], beta[keep], n_ray, phase)
     total = float(np.sum(weight[keep] * cos_n[keep] * units))
     return math.exp(-sigma * fr.dist) / fr.dist * total
 
 
 def spot_glow_irradiance(sigma_t: Any, sigma_s: Any, intensity: Any, position: Any, spot: Spot, point: Any,
-                         normal: Any, nodes: tuple[int, int, int] = GLOW_NODES) -> np.ndarray:
+                         normal: Any, nodes: tuple[int, int, int] = GLOW_NODES,
+                         phase: Any = None) -> np.ndarray:
     """E_glow (3,), W/m^2: the light a spot (axial intensity I0, RGB) scatters once onto a
     Lambertian point with unit normal `normal`, per channel
-    ``sigma_s / (4 pi) * I0 * spot_glow_unit(sigma_t, ...)`` (sigma_t, sigma_s, I0: RGB)."""
+    ``sigma_s / (4 pi) * I0 * spot_glow_unit(sigma_t, ...)`` (sigma_t, sigma_s, I0: RGB;
+    `phase` as in spot_glow_unit)."""
     sigma_t = np.broadcast_to(np.asarray(sigma_t, dtype=np.float64), (3,))
     sigma_s = np.broadcast_to(np.asarray(sigma_s, dtype=np.float64), (3,))
     intensity = np.broadcast_to(np.asarray(intensity, dtype=np.float64), (3,))
     out = np.zeros(3)
     for c in range(3):
         if sigma_s[c] > 0 and intensity[c] > 0:
-            unit = spot_glow_unit(float(sigma_t[c]), position, spot, point, normal, nodes)
+            unit = spot_glow_unit(float(sigma_t[c]), position, spot, point, normal, nodes, phase)
             out[c] = sigma_s[c] * intensity[c] / (4.0 * math.pi) * unit
     return out
 
@@ -730,7 +863,7 @@ def spot_glow_radiance(ss: SpotScene, point: np.ndarray, normal: np.ndarray,
         if float(np.linalg.norm(light.position - point)) < light.radius:
             raise ValueError("reference: surface point inside a spot's sphere (the renderer clamps D there)")
         out += spot_glow_irradiance(ss.sc.sigma_t, ss.sc.sigma_s, light.intensity, light.position, spot,
-                                    point, normal)
+                                    point, normal, phase=ss.phase)
     return albedo / math.pi * out
 
 
@@ -779,10 +912,19 @@ def rays_spot_airlight(ss: SpotScene, dirs: np.ndarray, t_hit: np.ndarray) -> np
                 continue
             sigma = float(sc.sigma_t[c])
             if sigma not in units:
-                units[sigma] = spot_unit_logs(sigma, sc.position, dirs, light.position, spot, x0, t_hit)
+                units[sigma] = spot_unit_logs(sigma, sc.position, dirs, light.position, spot, x0, t_hit,
+                                              ss.phase)
             log_scale = math.log(sc.sigma_s[c] * light.intensity[c] / (4.0 * math.pi))
             total[:, c] += np.exp(log_scale + units[sigma])
     return total
+
+
+def _check_point_lights_phase(ss: SpotScene) -> None:
+    """Point lights go through airlight_reference, which this module only trusts with an
+    isotropic phase unless its Scene carries a phase itself."""
+    if ss.phase is not None and ss.point_indices and not hasattr(ss.sc, "phase"):
+        raise NotImplementedError("spot_reference: point lights with an anisotropic phase are "
+                                  "airlight_reference's (it has no phase support here)")
 
 
 def spot_pixel_radiance(ss: SpotScene, rows: Sequence[int], cols: Sequence[int], glow: bool = True,
@@ -790,6 +932,7 @@ def spot_pixel_radiance(ss: SpotScene, rows: Sequence[int], cols: Sequence[int],
     """Reference radiance (N, 3) of the given pixels: points as airlight_reference, spots
     as above; surfaces get every lamp's glow (point lamps' and spots') when `glow`."""
     sc = ss.sc
+    _check_point_lights_phase(ss)
     points = ss.points_only()
     pidx = ss.point_indices
     dirs = camera_rays(sc, np.asarray(rows), np.asarray(cols))
@@ -851,6 +994,8 @@ def _gauss_pieces_estimate(ss: SpotScene, dirs: np.ndarray, x0: np.ndarray, x1: 
             prof = np.ones(len(dirs))
         else:
             prof = profile(-np.cos(psi) * fr.da - np.sin(psi) * fr.ma, spot)
+        if ss.phase is not None:
+            prof = prof * ss.phase(np.cos(psi))
         with np.errstate(over="ignore", invalid="ignore"):
             path = h * (np.tan(0.5 * psi) - t_lo)
             term = np.exp(-np.outer(path, sc.sigma_t))
