@@ -19,6 +19,7 @@ namespace airlight {
 namespace {
 
 using cdouble = std::complex<double>;
+constexpr double PHASE_GLOW_PANEL_RATIO = 2.2;
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kEulerGamma = 0.57721566490153286061;
 
@@ -82,9 +83,15 @@ bool register_table(const Table2D& table) {
 // width ~1/T, then uniform. Returns (g, weight) pairs.
 // Panel edges also sit at pi/2, where Phi has a kink for theta_s = 0 or pi,
 // and at the given extra points (the other places where Phi changes form).
-std::vector<std::pair<double, double>> glow_nodes(int scale, std::vector<double> extra_edges = {}) {
+// `backward_width` > 0 also grades them geometrically towards g = pi, where a
+// backward phase lobe of that width (~1 - |g|) peaks.
+std::vector<std::pair<double, double>> glow_nodes(int scale, std::vector<double> extra_edges = {},
+                                                  double backward_width = 0.0) {
     std::vector<double> edges = {0.0, 0.5 * kPi};
     for (double e = 1e-5; e < 0.5; e *= 1.0 + 0.6 / scale) edges.push_back(e);
+    if (backward_width > 0.0) {
+        for (double e = 1e-2 * backward_width; e < 0.5; e *= 1.0 + 0.6 / scale) edges.push_back(kPi - e);
+    }
     const int uniform_panels = 24 * scale;
     const double start = edges.back();
     for (int i = 1; i <= uniform_panels; ++i) edges.push_back(start + (kPi - start) * i / uniform_panels);
@@ -189,13 +196,13 @@ void parallel_for(int n, const Body& body) {
 // the medium's phase function. G = int_0^pi Q(T sin g, g / 2) Phi(g, theta_s) dg
 // (MODELS.md section 1; docs/airlight_table.md section 7).
 template <class Tail>
-Table2D build_glow_table(int width, int height, double k_min, const Tail& tail) {
+Table2D build_glow_table(int width, int height, double k_min, double backward_width, const Tail& tail) {
     using namespace shader;
     Table2D t;
     t.width = width;
     t.height = height;
     t.texels.resize(size_t(t.width) * t.height);
-    const auto nodes = glow_nodes(1);
+    const auto nodes = glow_nodes(1, {}, backward_width);
     parallel_for(t.width, [&](int ix) {
         const double X = double(ix) / (t.width - 1);
         const double t0 = double(SURFACE_GLOW_T_SCALE);
@@ -222,7 +229,7 @@ Table2D build_glow_table(int width, int height, double k_min, const Tail& tail) 
 }  // namespace
 
 Table2D build_surface_glow_table(int width, int height) {
-    return build_glow_table(width, height, shader::SURFACE_GLOW_K_MIN, airlight_tail_exact);
+    return build_glow_table(width, height, shader::SURFACE_GLOW_K_MIN, 0.0, airlight_tail_exact);
 }
 
 namespace {
@@ -315,7 +322,12 @@ shader::PhaseLobeGpu phase_lobe_gpu(const PhaseLobe& lobe, float weight) {
     return gpu;
 }
 
-void phase_tail_moments(const PhaseLobe& lobe, double u, double cv, double& Q, double& M1, double& M2, int refine) {
+namespace {
+
+// phase_tail_moments with panels growing by `ratio`; without `moments` only Q
+// is formed (the glow build), and Delta's steps need no panels.
+void phase_tail_quadrature(const PhaseLobe& lobe, double u, double cv, double ratio, bool moments, double& Q,
+                           double& M1, double& M2) {
     const double g = lobe.rayleigh ? 0.0 : double(lobe.g), k = (1.0 - g) / (1.0 + g);
     // tan phi0 = tan xi / k: cvp = pi/2 - phi0
     const double cvp = std::atan2(k * std::sin(cv), std::cos(cv));
@@ -323,11 +335,13 @@ void phase_tail_moments(const PhaseLobe& lobe, double u, double cv, double& Q, d
     if (!(cvp > 0.0)) return;
     const double s0 = std::sin(cvp), c0 = std::cos(cvp);
     // Panels graded geometrically from both ends: the weight's boundary layer
-    // of width 1 / lam at D = 0 and its decay towards phi = pi/2.
+    // of width 1 / lam at D = 0, its decay towards phi = pi/2, and the steps of
+    // Delta(phi) (the moments' arguments) of width ~min(k, 1/k) at either end.
     const double lam = u * k / (s0 * s0);
-    const double ratio = 1.0 + 0.6 / refine;
     std::vector<double> edges = {0.0, 0.5 * cvp, cvp};
-    for (double e = std::min(1e-3 / std::max(lam, 1e-300), 1e-3) * cvp / refine; e < 0.5 * cvp; e *= ratio) {
+    double first = std::min(1e-3 / std::max(lam, 1e-300), 1e-3);
+    if (moments) first = std::min(first, 1e-2 * std::min(k, 1.0 / k)) / (ratio < 1.5 ? 2.0 : 1.0);
+    for (double e = first * cvp; e < 0.5 * cvp; e *= ratio) {
         edges.push_back(e);
         edges.push_back(cvp - e);
     }
@@ -346,8 +360,9 @@ void phase_tail_moments(const PhaseLobe& lobe, double u, double cv, double& Q, d
                 density = std::sqrt(s1 * s1 + k * k * co1 * co1) / (1.0 - g);
             }
             const double w = half * kGl8w[j] * density * std::exp(-u * k * std::sin(D) / (s0 * s1));
-            const double delta = std::atan2(k * std::sin(D), s1 * s0 + k * k * co1 * c0);  // xi - xi0
             q += w;
+            if (!moments) continue;
+            const double delta = std::atan2(k * std::sin(D), s1 * s0 + k * k * co1 * c0);  // xi - xi0
             m1 += w * std::sin(2.0 * delta);
             m2 += w * std::sin(delta) * std::sin(delta);
         }
@@ -357,11 +372,19 @@ void phase_tail_moments(const PhaseLobe& lobe, double u, double cv, double& Q, d
     M2 = q > 0.0 ? m2 / q : 0.0;
 }
 
+}  // namespace
+
+void phase_tail_moments(const PhaseLobe& lobe, double u, double cv, double& Q, double& M1, double& M2, int refine) {
+    phase_tail_quadrature(lobe, u, cv, 1.0 + 0.6 / refine, true, Q, M1, M2);
+}
+
 namespace {
 
+// Q_p alone, for the glow build: panels growing by 2.2 (measured: within
+// 2e-7 of the finer rule, test_phase_tables).
 double phase_tail(const PhaseLobe& lobe, double u, double cv) {
     double Q, M1, M2;
-    phase_tail_moments(lobe, u, cv, Q, M1, M2);
+    phase_tail_quadrature(lobe, u, cv, PHASE_GLOW_PANEL_RATIO, false, Q, M1, M2);
     return Q;
 }
 
@@ -455,13 +478,17 @@ const Table2D& lobe_table(const PhaseLobe& lobe, bool glow) {
 
 Table2D build_phase_glow_table(const PhaseLobe& lobe, int width, int height) {
     const double k_min = phase_lobe_gpu(lobe, 1.0f).info.z;
-    return build_glow_table(width, height, k_min, [&](double u, double cv) { return phase_tail(lobe, u, cv); });
+    const double backward_width = !lobe.rayleigh && lobe.g < 0.0f ? 1.0 + double(lobe.g) : 0.0;
+    return build_glow_table(width, height, k_min, backward_width,
+                            [&](double u, double cv) { return phase_tail(lobe, u, cv); });
 }
 
 double phase_surface_glow_exact(const PhaseLobe& lobe, double optical_distance, double theta_s) {
     double sum = 0.0;
     const double h = 0.5 * kPi;
-    for (const auto& [g, w] : glow_nodes(2, {h - theta_s, theta_s - h, h + theta_s, 3.0 * h - theta_s})) {
+    const double backward_width = lobe.rayleigh ? 0.0 : std::max(1.0 - std::abs(double(lobe.g)), 1e-3);
+    for (const auto& [g, w] :
+         glow_nodes(2, {h - theta_s, theta_s - h, h + theta_s, 3.0 * h - theta_s}, backward_width)) {
         const double ring = clamped_cosine_ring(g, theta_s);
         if (ring == 0.0) continue;
         double Q, M1, M2;

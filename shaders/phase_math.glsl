@@ -49,7 +49,8 @@ INLINE float lobe_density(PhaseLobeGpu lobe, float cp) {
 //   X = sqrt(z / (1 + z)),  z = sigma sqrt(c^2 h^2 + p^2)
 //   Y = 1 - 2 / (3 pi) [atan(h, p) + atan(sqrt(k) h, p) + atan(k h, p)]
 //   N  = Ct / (1 + lam' Ct / rho(phi_e)) / (1 - g)  (Q_p = N S)
-//   N1 = 2 eps / (1 + eps / cv), eps = N / P(xi)     (spot moment M1 = N1 (M1/N1))
+//   N1 = 2 eps / (1 + eps / cv), eps = N / P(xi)     (spot moment M1 = N1 (M1/N1);
+//                                                     eps = N for Rayleigh)
 // At g = 0 each is the isotropic formula of constants.glsl. cvp = pi/2 - phi0
 // and cv = pi/2 - xi are returned for the short-segment rules.
 INLINE void lobe_coordinates(PhaseLobeGpu lobe, float sigma, float h, float p, OUT(float) X, OUT(float) Y,
@@ -71,7 +72,9 @@ INLINE void lobe_coordinates(PhaseLobeGpu lobe, float sigma, float h, float p, O
     float ke = k * cos(ce);
     float rho_e = lobe.info.y != 0.0f ? 1.0f : sqrt(se * se + ke * ke);  // Rayleigh: the isotropic N
     N = Ct / (1.0f + lam * Ct / rho_e) * lobe.shape.w;
+    // eps, the tail's width: N / P(xi) for HG, whose N carries the peak; the
+    // isotropic width N for Rayleigh, whose N is the isotropic one.
     float d2 = h * h + p * p;
-    float eps = N / lobe_phase_at(lobe, p * p / d2, h * h / d2);
+    float eps = lobe.info.y != 0.0f ? N : N / lobe_phase_at(lobe, p * p / d2, h * h / d2);
     N1 = 2.0f * eps / (1.0f + eps / max(cv, 1.0e-30f));
 }

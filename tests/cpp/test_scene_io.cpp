@@ -72,7 +72,10 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
               a.surfaces.size() == b.surfaces.size();
     if (!ok) return false;
     if (a.has_medium && !(same(a.medium.sigma_t, b.medium.sigma_t) && same(a.medium.albedo, b.medium.albedo) &&
-                          a.medium.phase.type == b.medium.phase.type))
+                          a.medium.phase.type == b.medium.phase.type && a.medium.phase.g == b.medium.phase.g &&
+                          a.medium.phase.forward_g == b.medium.phase.forward_g &&
+                          a.medium.phase.backward_g == b.medium.phase.backward_g &&
+                          a.medium.phase.forward_weight == b.medium.phase.forward_weight))
         return false;
     for (std::size_t i = 0; i < a.point_lights.size(); ++i) {
         const auto &x = a.point_lights[i], &y = b.point_lights[i];
@@ -258,8 +261,36 @@ const std::vector<BadCase> bad_cases = {
      Kind::value, "medium.albedo", "must be <= 1"},
     {"medium albedo < 0", [](json& j) { j["medium"]["albedo"] = -0.1; }, Kind::value, "medium.albedo", "must be >= 0"},
     {"medium typo", [](json& j) { j["medium"]["sigma"] = 1; }, Kind::value, "medium.sigma", "did you mean 'sigma_t'?"},
-    {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "hg"; }, Kind::value, "medium.phase.type",
+    {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "mie"; }, Kind::value, "medium.phase.type",
      "isotropic"},
+    {"hg without g", [](json& j) { j["medium"]["phase"]["type"] = "hg"; }, Kind::value, "medium.phase.g",
+     "missing required key"},
+    {"hg g = 1", [](json& j) { j["medium"]["phase"] = {{"type", "hg"}, {"g", 1.0}}; }, Kind::value, "medium.phase.g",
+     "(-1, 1)"},
+    {"hg g = -1", [](json& j) { j["medium"]["phase"] = {{"type", "hg"}, {"g", -1}}; }, Kind::value, "medium.phase.g",
+     "(-1, 1)"},
+    {"hg g rounds to 1 as a float", [](json& j) { j["medium"]["phase"] = {{"type", "hg"}, {"g", 0.99999999999}}; },
+     Kind::value, "medium.phase.g", "(-1, 1)"},
+    {"hg g a string", [](json& j) { j["medium"]["phase"] = {{"type", "hg"}, {"g", "0.8"}}; }, Kind::type,
+     "medium.phase.g", "expected a number"},
+    {"isotropic with g", [](json& j) { j["medium"]["phase"] = {{"type", "isotropic"}, {"g", 0.5}}; }, Kind::value,
+     "medium.phase.g", "unknown key"},
+    {"rayleigh with g", [](json& j) { j["medium"]["phase"] = {{"type", "rayleigh"}, {"g", 0.5}}; }, Kind::value,
+     "medium.phase.g", "unknown key"},
+    {"hg2 weight > 1",
+     [](json& j) {
+         j["medium"]["phase"] = {{"type", "hg2"}, {"forward_g", 0.8}, {"backward_g", -0.3}, {"forward_weight", 1.5}};
+     },
+     Kind::value, "medium.phase.forward_weight", "[0, 1]"},
+    {"hg2 backward_g missing",
+     [](json& j) { j["medium"]["phase"] = {{"type", "hg2"}, {"forward_g", 0.8}, {"forward_weight", 0.5}}; },
+     Kind::value, "medium.phase.backward_g", "missing required key"},
+    {"hg2 typo",
+     [](json& j) {
+         j["medium"]["phase"] = {
+             {"type", "hg2"}, {"forward_g", 0.8}, {"backward_g", -0.3}, {"forward_weight", 0.5}, {"forward_gg", 1}};
+     },
+     Kind::value, "medium.phase.forward_gg", "did you mean 'forward_g'?"},
     {"phase type missing", [](json& j) { j["medium"]["phase"] = json::object(); }, Kind::value, "medium.phase.type",
      "missing required key"},
     {"phase type number", [](json& j) { j["medium"]["phase"]["type"] = 3; }, Kind::type, "medium.phase.type",
@@ -715,6 +746,22 @@ void test_round_trip() {
         json j = json::parse(readme_example);
         j["camera"] = {{"position", vec()}, {"look_at", vec()}, {"up", vec()}, {"fov_y", 0.01 + 179.98 * unit(rng)}};
         j["medium"] = {{"sigma_t", std::pow(10.0, expo(rng))}, {"albedo", {unit(rng), unit(rng), unit(rng)}}};
+        switch (i % 4) {  // every phase type, with random parameters
+            case 0:
+                j["medium"]["phase"] = {{"type", "isotropic"}};
+                break;
+            case 1:
+                j["medium"]["phase"] = {{"type", "hg"}, {"g", 2.0 * unit(rng) - 1.0}};
+                break;
+            case 2:
+                j["medium"]["phase"] = {{"type", "rayleigh"}};
+                break;
+            default:
+                j["medium"]["phase"] = {{"type", "hg2"},
+                                        {"forward_g", unit(rng)},
+                                        {"backward_g", -unit(rng)},
+                                        {"forward_weight", unit(rng)}};
+        }
         j["lights"][0]["radius"] = 1e-3 + unit(rng);
         json spot = {{"type", "spot"},
                      {"position", vec()},

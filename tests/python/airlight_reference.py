@@ -26,6 +26,14 @@ renderer's tables, tail folding, short-segment rule or closed forms.
   smoothstep map on pieces split where the lit arc changes shape, and each airlight by
   ``quad``. 24 nodes per piece converge to about 1e-8 (checked by doubling in
   test_airlight_surface_glow.py).
+* Phase functions (issue 5): the scene's ``medium.phase`` is read into ``Scene.phase``
+  (phase_reference.Phase, |g| clamped to 0.999 as the renderer documents). An isotropic
+  phase takes exactly the paths above; any other takes phase_reference's quadrature of the
+  defining integral in the xi variable (the phase function evaluated at every node), and
+  the glow the same polar reduction (the airlight of a ray leaving the surface still depends
+  only on the angle alpha between the ray and the direction to the light: the scattering
+  angle at parameter x is theta with cos theta = (b - x) / d), its pieces also graded
+  towards the phase function's lobes (alpha ~ 1 - |g| forward, pi - alpha backward).
 """
 
 from __future__ import annotations
@@ -39,6 +47,7 @@ from dataclasses import dataclass, field
 from typing import Any
 
 import numpy as np
+from phase_reference import ISOTROPIC, Phase, airlight_x_log, airlight_xi_log, parse_phase
 from reference import _INTERSECT as _REFERENCE_INTERSECT
 from scipy.integrate import IntegrationWarning, quad
 
@@ -95,6 +104,7 @@ class Scene:
     surfaces: list[Surface] = field(default_factory=list)
     background: np.ndarray = field(default_factory=lambda: np.zeros(3))
     cull_fraction: float = DEFAULT_CULL_FRACTION
+    phase: Phase = ISOTROPIC
 
 
 def parse_scene(scene: Any) -> Scene:
@@ -110,12 +120,14 @@ def parse_scene(scene: Any) -> Scene:
     right /= np.linalg.norm(right)
     up = np.cross(right, forward)
     medium = scene.get("medium")
+    phase = ISOTROPIC
     if medium is None:
         sigma_t = np.zeros(3)
         albedo = np.zeros(3)
     else:
         sigma_t = _rgb(medium["sigma_t"], 0.0)
         albedo = _rgb(medium.get("albedo"), 1.0)
+        phase = parse_phase(medium.get("phase"))
     lights = [Light(_vec3(li["position"]), _rgb(li["intensity"], 0.0),
                     float(li.get("radius", DEFAULT_LAMP_RADIUS))) for li in scene.get("lights", [])]
     surfaces = []
@@ -138,6 +150,7 @@ def parse_scene(scene: Any) -> Scene:
         sigma_t=sigma_t, sigma_s=albedo * sigma_t, lights=lights, surfaces=surfaces,
         background=_rgb(scene.get("background"), 0.0),
         cull_fraction=float(quality.get("cull_fraction", DEFAULT_CULL_FRACTION)),
+        phase=phase,
     )
 
 
@@ -291,6 +304,17 @@ def airlight(sigma_t: float, sigma_s: float, intensity: float, b: float, h: floa
     return math.exp(airlight_log(sigma_t, sigma_s, intensity, b, h, x0, x1))
 
 
+def airlight_phase(sigma_t: float, sigma_s: float, intensity: float, b: float, h: float,
+                   x0: float = 0.0, x1: float = math.inf, phase: Phase = ISOTROPIC) -> float:
+    """:func:`airlight` with a phase function: the isotropic one is :func:`airlight` itself,
+    any other phase_reference's xi quadrature (x quadrature where h = 0)."""
+    if phase.isotropic:
+        return airlight(sigma_t, sigma_s, intensity, b, h, x0, x1)
+    if h > 0:
+        return math.exp(airlight_xi_log(sigma_t, sigma_s, intensity, b, h, x0, x1, phase))
+    return math.exp(airlight_x_log(sigma_t, sigma_s, intensity, b, h, x0, x1, phase))
+
+
 def ray_light_geometry(origin: np.ndarray, direction: np.ndarray, light: Light) -> tuple[float, float, float]:
     """(b, h, x0) of a light for the ray origin + x direction: closest approach, closest
     distance, and where the visible fog starts (0, or where the ray leaves the lamp's
@@ -310,7 +334,8 @@ def ray_airlight(sc: Scene, origin: np.ndarray, direction: np.ndarray, t_hit: fl
     for light in sc.lights:
         b, h, x0 = ray_light_geometry(origin, direction, light)
         for c in range(3):
-            total[c] += airlight(sc.sigma_t[c], sc.sigma_s[c], light.intensity[c], b, h, x0, t_hit)
+            total[c] += airlight_phase(sc.sigma_t[c], sc.sigma_s[c], light.intensity[c], b, h, x0, t_hit,
+                                       sc.phase)
     return total
 
 
@@ -349,11 +374,17 @@ def _smoothstep_gauss(n: int) -> tuple[np.ndarray, np.ndarray]:
     return t * t * (3.0 - 2.0 * t), 0.5 * w * 6.0 * t * (1.0 - t)
 
 
-def glow_unit(sigma_t: float, dist: float, cos_theta_s: float, nodes: int = GLOW_NODES) -> float:
+def glow_unit(sigma_t: float, dist: float, cos_theta_s: float, nodes: int = GLOW_NODES,
+              phase: Phase = ISOTROPIC) -> float:
     """Irradiance from the light scattered once by the medium at a surface point at
     distance dist from a light, per unit sigma_s * I: the cosine-weighted hemisphere
-    integral of the (unshadowed) airlight of the infinite ray leaving the point."""
-    return _glow_unit_cached(float(sigma_t), float(dist), float(np.clip(cos_theta_s, -1.0, 1.0)), int(nodes))
+    integral of the (unshadowed) airlight of the infinite ray leaving the point. Along the
+    ray from the point in direction w, the scattering angle at y is between (y - light)
+    and -w (0: the light goes on towards the point)."""
+    cos_s = float(np.clip(cos_theta_s, -1.0, 1.0))
+    if phase.isotropic:
+        return _glow_unit_cached(float(sigma_t), float(dist), cos_s, int(nodes))
+    return _glow_unit_phase_cached(float(sigma_t), float(dist), cos_s, int(nodes), phase)
 
 
 @functools.lru_cache(maxsize=100_000)
@@ -379,11 +410,45 @@ def _glow_unit_cached(sigma_t: float, dist: float, cos_s: float, nodes: int) -> 
     return total
 
 
+@functools.lru_cache(maxsize=100_000)
+def _glow_unit_phase_cached(sigma_t: float, dist: float, cos_s: float, nodes: int, phase: Phase) -> float:
+    """glow_unit for an anisotropic phase: the same polar reduction, each ray's airlight by
+    phase_reference's xi rule, the alpha pieces also graded towards the lobes."""
+    theta = math.acos(cos_s)
+    sin_s = math.sin(theta)
+    lo, hi = max(0.0, theta - math.pi / 2), min(math.pi, theta + math.pi / 2)
+    breaks = [p for p in (math.pi / 2 - theta, 1.5 * math.pi - theta) if lo < p < hi]
+    optical = sigma_t * dist
+    if optical > 1.0 and lo == 0.0:
+        breaks += [p for p in (1.0 / math.sqrt(optical), 4.0 / math.sqrt(optical)) if lo < p < hi]
+    for _, w in phase.widths():  # a lobe of width w shapes the glow at alpha ~ w and pi - alpha ~ w
+        k = -6
+        while w * 2.0 ** k < math.pi:
+            a = w * 2.0 ** k
+            breaks += [p for p in (a, math.pi - a) if lo < p < hi]
+            k += 1
+    edges = [lo] + sorted(set(breaks)) + [hi]
+    s, w = _smoothstep_gauss(nodes)
+    total = 0.0
+    for a, c in zip(edges[:-1], edges[1:]):
+        for si, wi in zip(s, w):
+            alpha = a + (c - a) * si
+            weight = _lit_azimuth_weight(alpha, cos_s, sin_s) * math.sin(alpha)
+            if weight <= 0.0:
+                continue
+            lg = airlight_xi_log(sigma_t, 1.0, 1.0, dist * math.cos(alpha), dist * math.sin(alpha),
+                                 phase=phase)
+            total += wi * (c - a) * weight * math.exp(lg)
+    return total
+
+
 def glow_hemisphere_bruteforce(sigma_t: float, dist: float, cos_theta_s: float, n_polar: int = 32,
-                               n_azimuth: int = 64) -> float:
+                               n_azimuth: int = 64, phase: Phase = ISOTROPIC) -> float:
     """glow_unit by a plain product rule over the hemisphere in the normal's own polar
     coordinates (for checking the reduction above; only accurate when the light is
-    below the horizon, cos_theta_s < 0, so that the integrand has no singularity)."""
+    below the horizon, cos_theta_s < 0, so that the integrand has no singularity). With
+    an anisotropic phase each ray's airlight is phase_reference's quadrature in x (not the
+    xi rule that glow_unit uses)."""
     theta_s = math.acos(cos_theta_s)
     to_light = np.array([math.sin(theta_s), 0.0, cos_theta_s])  # normal = +z
     xp, wp = np.polynomial.legendre.leggauss(n_polar)
@@ -396,8 +461,11 @@ def glow_hemisphere_bruteforce(sigma_t: float, dist: float, cos_theta_s: float, 
             omega = np.array([math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph), math.cos(th)])
             b = dist * float(omega @ to_light)
             h = dist * float(np.linalg.norm(to_light - (b / dist) * omega))
-            total += w * (2.0 * math.pi / n_azimuth) * math.cos(th) * math.sin(th) * airlight(
-                sigma_t, 1.0, 1.0, b, h)
+            if phase.isotropic:
+                ray = airlight(sigma_t, 1.0, 1.0, b, h)
+            else:
+                ray = math.exp(airlight_x_log(sigma_t, 1.0, 1.0, b, h, phase=phase, epsrel=1e-9))
+            total += w * (2.0 * math.pi / n_azimuth) * math.cos(th) * math.sin(th) * ray
     return total
 
 
@@ -419,7 +487,7 @@ def surface_radiance(sc: Scene, point: np.ndarray, normal: np.ndarray, albedo: n
                 raise ValueError("reference: surface point inside a lamp (the renderer clamps D there)")
             for c in range(3):
                 if sc.sigma_s[c] > 0 and light.intensity[c] > 0:
-                    glow_c = glow_unit(sc.sigma_t[c], dist, cos_s)
+                    glow_c = glow_unit(sc.sigma_t[c], dist, cos_s, phase=sc.phase)
                     irradiance[c] += sc.sigma_s[c] * light.intensity[c] * glow_c
     return albedo / math.pi * irradiance
 
@@ -533,8 +601,10 @@ def sphere(center: Sequence[float], radius: float, albedo: Any = 0.5) -> dict[st
 def make_scene(position: Sequence[float], look_at: Sequence[float], lights: list[dict[str, Any]],
                surfaces: list[dict[str, Any]] | None = None, sigma_t: Any = 0.1, albedo: Any = 1.0,
                fov_y: float = 60.0, width: int = 48, height: int = 32, cull_fraction: float | None = 0.0,
-               up: Sequence[float] = (0.0, 1.0, 0.0)) -> dict[str, Any]:
-    """A scene dict; sigma_t None means no medium; cull_fraction None keeps the default."""
+               up: Sequence[float] = (0.0, 1.0, 0.0),
+               phase: Mapping[str, Any] | None = None) -> dict[str, Any]:
+    """A scene dict; sigma_t None means no medium; cull_fraction None keeps the default;
+    phase: the medium's phase (None: isotropic)."""
     scene: dict[str, Any] = {
         "film": {"width": width, "height": height},
         "camera": {"position": [float(v) for v in position], "look_at": [float(v) for v in look_at],
@@ -544,7 +614,8 @@ def make_scene(position: Sequence[float], look_at: Sequence[float], lights: list
         "background": [0.0, 0.0, 0.0],
     }
     if sigma_t is not None:
-        scene["medium"] = {"sigma_t": sigma_t, "albedo": albedo, "phase": {"type": "isotropic"}}
+        scene["medium"] = {"sigma_t": sigma_t, "albedo": albedo,
+                           "phase": dict(phase) if phase is not None else {"type": "isotropic"}}
     if cull_fraction is not None:
         scene["quality"] = {"cull_fraction": cull_fraction}
     return scene

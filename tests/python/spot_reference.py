@@ -158,6 +158,12 @@ class Phase:
         raise ValueError(f"unknown phase kind {self.kind!r}")
 
     @property
+    def constant(self) -> bool:
+        """4 pi p = 1 everywhere (isotropic, or HG lobes with g = 0)."""
+        return self.kind == "isotropic" or (self.kind in ("hg", "hg2") and self.g == 0.0
+                                            and (self.kind == "hg" or self.g2 == 0.0))
+
+    @property
     def peaks(self) -> tuple[tuple[float, float], ...]:
         """Narrow lobes as (+1 forward | -1 backward, angular width ~ 1 - |g|): HG lobes with
         |g| >= 0.5 (wider ones need no break points)."""
@@ -179,6 +185,11 @@ def is_isotropic(phase: Any) -> bool:
 
 def phase_peaks(phase: Any) -> tuple[tuple[float, float], ...]:
     return tuple(getattr(phase, "peaks", ())) if phase is not None else ()
+
+
+def phase_varies(phase: Any) -> bool:
+    """False for None and constant Phases; True for any other phase (callables included)."""
+    return phase is not None and not getattr(phase, "constant", False)
 
 
 def parse_phase(value: Any) -> Phase:
@@ -674,7 +685,7 @@ def _alpha_breaks(fr: GlowFrame, sigma: float, normal: np.ndarray, axis: np.ndar
     return np.array(keys), np.array([points[k] for k in keys])
 
 
-def _beta_breaks(fr: GlowFrame, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
+def _beta_breaks(fr: GlowFrame, alpha: np.ndarray, phase: Any = None) -> tuple[np.ndarray, np.ndarray]:
     """Per alpha (N,): break points in beta (N, K) (sorted; a full circle ends at its first
     point + 2 pi) and their kinds: the horizon, the tangent great circles, the cone's circle
     of directions, and nearby complex singularities (the circle almost reached; the lit arc
@@ -690,14 +701,33 @@ def _beta_breaks(fr: GlowFrame, alpha: np.ndarray) -> tuple[np.ndarray, np.ndarr
     opposite = float(_wrap(fr.beta_a + math.pi))  # a plain point for full circles
     cols = [np.where(full, opposite, -b_max), np.where(full, opposite, b_max)]
     kinds = [np.where(full, _PLAIN, _SMOOTH)] * 2
+    # a forward lobe with P near the wall: the lit start psi_lo(beta) leaves 0 at a tangent azimuth,
+    # sweeping the lobe over a small range of beta (small alpha only)
+    wall_gap = abs(math.acos(float(np.clip(-fr.cos_g, -1.0, 1.0))) - math.acos(fr.cos_a))
+    lobes = [width for side, width in phase_peaks(phase) if side > 0 and wall_gap < 8.0 * width]
     for bt in _tangent_azimuths(fr):
         cols.append(np.full_like(alpha, float(_wrap(bt))))
         kinds.append(smooth)
+        for width in lobes:
+            near = alpha < 16.0 * width
+            for k in range(-2, 3):
+                for sgn in (1.0, -1.0):
+                    cols.append(np.where(near, _wrap(bt + sgn * width * 2.0 ** k), cols[0]))
+                    kinds.append(np.where(near, _PLAIN, kinds[0]))
     crosses = np.abs(c_cone) <= 1.0
     d = np.arccos(np.clip(np.nan_to_num(c_cone), -1.0, 1.0))
     for sgn in (1.0, -1.0):
         cols.append(np.where(crosses, _wrap(fr.beta_a + sgn * d), cols[0]))
         kinds.append(np.where(crosses, _FINE, kinds[0]))
+        # a backward lobe: whether the far end of the ray is lit changes at the crossing, and
+        # the lobe (at z < width) makes that part weigh over a small range of beta
+        for side, width in phase_peaks(phase):
+            if side < 0:
+                for k in range(-2, 3):
+                    for off in (1.0, -1.0):
+                        cols.append(np.where(crosses, _wrap(fr.beta_a + sgn * d + off * width * 2.0 ** k),
+                                             cols[0]))
+                        kinds.append(np.where(crosses, _PLAIN, kinds[0]))
     near = np.arccosh(np.clip(np.abs(np.nan_to_num(c_cone, nan=10.0, posinf=10.0, neginf=10.0)), 1.0, 10.0))
     near_ok = ~crosses & (near < 1.0)
     cols.append(np.where(near_ok, _wrap(fr.beta_a + np.where(c_cone < 0, math.pi, 0.0)), cols[0]))
@@ -762,9 +792,14 @@ def glow_ray_units(fr: GlowFrame, sigma: float, alpha: np.ndarray, beta: np.ndar
                 zk = 2.0 * np.arctan2(1.0, np.tan(half) + (x_lo + level) / scale)  # x(z) = x_lo + level
                 zs.append(np.where(np.isfinite(zk), zk, 0.0))
         z_cut = zs.pop()
-    for side, width in phase_peaks(phase):  # z = pi - (scattering angle): a lobe's scale
-        for f in (0.125, 0.5, 2.0, 8.0):
-            zs.append(np.full(len(idx), math.pi - width * f if side > 0 else width * f))
+    if phase_varies(phase):  # the phase varies on the scale 1 of z: no long graded piece across it
+        zs += [np.full(len(idx), 2.0 ** -k) for k in range(-1, 4)]
+    for side, width in phase_peaks(phase):  # z = pi - (scattering angle alpha + psi)
+        if side > 0:  # the forward lobe: psi on a geometric grid from the scale hypot(width, alpha)
+            scale = np.hypot(width, al)
+            zs += [end - scale * 2.0 ** k for k in range(-2, 7)]
+        else:  # the backward lobe, towards infinity
+            zs += [np.full(len(idx), width * f) for f in (0.125, 0.5, 2.0, 8.0)]
     z_end = np.maximum(z_hi, z_cut)
     zz = np.clip(np.stack(zs + [z_end], axis=1), z_end[:, None], z_lo[:, None])
     zz = -np.sort(-zz, axis=1)  # decreasing: from the lit start towards infinity
@@ -821,7 +856,7 @@ def _spot_glow_unit_cached(key: tuple) -> float:
     n = n / np.linalg.norm(n)
     edges, kinds = _alpha_breaks(fr, sigma, n, np.asarray(axis), phase)
     alpha, w_alpha = (v.ravel() for v in _piece_rule(edges, kinds, n_alpha))
-    br, kd = _beta_breaks(fr, alpha)
+    br, kd = _beta_breaks(fr, alpha, phase)
     beta, w_beta = _piece_rule(br, kd, n_beta)
     per = beta.shape[1] * beta.shape[2]
     alpha = np.repeat(alpha, per)

@@ -51,6 +51,15 @@ def _rename(path: str, new_key: str) -> Callable[[dict], None]:
 
 
 NAN, INF = float("nan"), float("inf")
+_MISSING = object()
+
+
+def _hg2(**changes: Any) -> Callable[[dict], None]:
+    """Mutation setting medium.phase to a valid hg2 phase with `changes` (_MISSING: key removed)."""
+    phase: dict[str, Any] = {"type": "hg2", "forward_g": 0.9, "backward_g": -0.3, "forward_weight": 0.85}
+    phase.update(changes)
+    return _set("medium.phase", {k: v for k, v in phase.items() if v is not _MISSING})
+
 
 # (id, mutation, exception type, field the message must start with)
 BAD_SCENES = [
@@ -107,7 +116,42 @@ BAD_SCENES = [
     ("zero_plane_normal", _set("surfaces[0].normal", [0, 0, 0]), ValueError, "surfaces[0].normal"),
     ("unknown_light_type", _set("lights[0].type", "area"), ValueError, "lights[0].type"),
     ("unknown_surface_type", _set("surfaces[1].type", "cylinder"), ValueError, "surfaces[1].type"),
-    ("unknown_phase_type", _set("medium.phase.type", "rayleigh"), ValueError, "medium.phase.type"),
+    ("unknown_phase_type", _set("medium.phase.type", "mie"), ValueError, "medium.phase.type"),
+    # medium.phase (issue 5): hg {g}, rayleigh, hg2 {forward_g, backward_g, forward_weight}
+    ("phase_not_an_object", _set("medium.phase", "hg"), TypeError, "medium.phase"),
+    ("phase_list", _set("medium.phase", [{"type": "hg", "g": 0.5}]), TypeError, "medium.phase"),
+    ("phase_missing_type", _set("medium.phase", {"g": 0.5}), ValueError, "medium.phase.type"),
+    ("phase_type_not_a_string", _set("medium.phase", {"type": 1}), TypeError, "medium.phase.type"),
+    ("hg_missing_g", _set("medium.phase", {"type": "hg"}), ValueError, "medium.phase.g"),
+    ("hg_g_1", _set("medium.phase", {"type": "hg", "g": 1}), ValueError, "medium.phase.g"),
+    ("hg_g_minus_1", _set("medium.phase", {"type": "hg", "g": -1.0}), ValueError, "medium.phase.g"),
+    ("hg_g_above_1", _set("medium.phase", {"type": "hg", "g": 1.5}), ValueError, "medium.phase.g"),
+    ("hg_g_nan", _set("medium.phase", {"type": "hg", "g": NAN}), ValueError, "medium.phase.g"),
+    ("hg_g_inf", _set("medium.phase", {"type": "hg", "g": -INF}), ValueError, "medium.phase.g"),
+    ("hg_g_string", _set("medium.phase", {"type": "hg", "g": "0.5"}), TypeError, "medium.phase.g"),
+    ("hg_g_bool", _set("medium.phase", {"type": "hg", "g": True}), TypeError, "medium.phase.g"),
+    ("hg_g_null", _set("medium.phase", {"type": "hg", "g": None}), TypeError, "medium.phase.g"),
+    ("hg_g_list", _set("medium.phase", {"type": "hg", "g": [0.5, 0.5, 0.5]}), TypeError, "medium.phase.g"),
+    ("hg_misspelt_g", _set("medium.phase", {"type": "hg", "G": 0.5}), ValueError, "medium.phase.G"),
+    ("hg_key_of_hg2", _set("medium.phase", {"type": "hg", "g": 0.5, "forward_weight": 1.0}), ValueError,
+     "medium.phase.forward_weight"),
+    ("isotropic_with_g", _set("medium.phase", {"type": "isotropic", "g": 0.5}), ValueError, "medium.phase.g"),
+    ("rayleigh_with_g", _set("medium.phase", {"type": "rayleigh", "g": 0.0}), ValueError, "medium.phase.g"),
+    ("hg2_with_g", _hg2(g=0.5), ValueError, "medium.phase.g"),
+    ("hg2_missing_forward_g", _hg2(forward_g=_MISSING), ValueError, "medium.phase.forward_g"),
+    ("hg2_missing_backward_g", _hg2(backward_g=_MISSING), ValueError, "medium.phase.backward_g"),
+    ("hg2_missing_weight", _hg2(forward_weight=_MISSING), ValueError, "medium.phase.forward_weight"),
+    ("hg2_forward_g_1", _hg2(forward_g=1.0), ValueError, "medium.phase.forward_g"),
+    ("hg2_forward_g_string", _hg2(forward_g="0.9"), TypeError, "medium.phase.forward_g"),
+    ("hg2_backward_g_minus_1", _hg2(backward_g=-1), ValueError, "medium.phase.backward_g"),
+    ("hg2_backward_g_nan", _hg2(backward_g=NAN), ValueError, "medium.phase.backward_g"),
+    ("hg2_weight_above_1", _hg2(forward_weight=1.5), ValueError, "medium.phase.forward_weight"),
+    ("hg2_weight_negative", _hg2(forward_weight=-0.1), ValueError, "medium.phase.forward_weight"),
+    ("hg2_weight_nan", _hg2(forward_weight=NAN), ValueError, "medium.phase.forward_weight"),
+    ("hg2_weight_inf", _hg2(forward_weight=INF), ValueError, "medium.phase.forward_weight"),
+    ("hg2_weight_string", _hg2(forward_weight="0.5"), TypeError, "medium.phase.forward_weight"),
+    ("hg2_weight_bool", _hg2(forward_weight=True), TypeError, "medium.phase.forward_weight"),
+    ("hg2_unknown_key", _hg2(third_g=0.1), ValueError, "medium.phase.third_g"),
     ("box_min_equals_max", _set("surfaces[1].max", [-8.0, 12.0, -25.0]), ValueError, "surfaces[1].max"),
     ("box_min_above_max", _set("surfaces[1].min", [-3.0, 0.0, -40.0]), ValueError, "surfaces[1].max"),
     ("zero_sphere_radius", _set("surfaces[2].radius", 0), ValueError, "surfaces[2].radius"),
@@ -380,6 +424,35 @@ def test_random_valid_scenes_render_finite_non_negative_radiance(scene, renderer
         assert not bad.any(), (
             f"{renderer.backend}: {int(bad.sum())} bad values, e.g. {img[bad][:4]!r} "
             f"at {np.argwhere(bad)[:2].tolist()}")
+
+
+@pytest.mark.parametrize("phase", [
+    {"type": "isotropic"}, {"type": "rayleigh"}, {"type": "hg", "g": 0.85}, {"type": "hg", "g": -0.9999},
+    {"type": "hg", "g": 0.9995}, {"type": "hg", "g": 0},
+    {"type": "hg2", "forward_g": 0.9, "backward_g": -0.3, "forward_weight": 0.85},
+    {"type": "hg2", "forward_g": 0.5, "backward_g": 0.5, "forward_weight": 0},
+    {"type": "hg2", "forward_g": -0.2, "backward_g": 0.7, "forward_weight": 1}], ids=repr)
+def test_valid_phases_load_and_round_trip(phase) -> None:
+    """Every phase type of the format loads with its values kept (g in the open interval
+    (-1, 1), beyond the rendering clamp of 0.999 included; forward_weight in the closed
+    [0, 1]), and a loaded scene loads again to itself."""
+    scene = copy.deepcopy(VALID)
+    scene["medium"]["phase"] = copy.deepcopy(phase)
+    loaded = airlight.load_scene(scene)
+    got = loaded["medium"]["phase"]
+    assert sorted(got) == sorted(phase)
+    assert got["type"] == phase["type"]
+    for key, value in phase.items():
+        if key != "type":
+            assert got[key] == pytest.approx(value, rel=1e-7, abs=1e-12), key
+    assert airlight.load_scene(loaded) == loaded
+
+
+def test_phase_defaults_to_isotropic() -> None:
+    """A medium without "phase" gets {"type": "isotropic"} filled in."""
+    scene = copy.deepcopy(VALID)
+    del scene["medium"]["phase"]
+    assert airlight.load_scene(scene)["medium"]["phase"] == {"type": "isotropic"}
 
 
 def test_light_radius_default_and_bounds_follow_the_format() -> None:
