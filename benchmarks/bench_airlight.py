@@ -2,6 +2,7 @@
 
     .venv/bin/python benchmarks/bench_airlight.py [--lamps 1 4 16 64] [--steps 8 16 ... 1024]
         [--width 640 --height 360] [--samples 300] [--plot docs/images/bench_airlight.png]
+        [--light-type point|spot|headlights] [--phase isotropic|rayleigh|hg:G|hg2:G1,G2,W]
 
 Scenes: a foggy street at night (sigma_t 0.04/m, albedo 0.9) with 1, 4, 16 and
 64 lamps along both sides and buildings as boxes. The surfaces are black
@@ -40,6 +41,37 @@ import airlight
 
 SIGMA_T = 0.04
 ALBEDO = 0.9
+# The medium's phase function (--phase), in the scene format's medium.phase form.
+PHASE: dict = {"type": "isotropic"}
+
+
+def parse_phase(text: str) -> dict:
+    """--phase isotropic | rayleigh | hg:G | hg2:G_FORWARD,G_BACKWARD,W_FORWARD."""
+    kind, _, params = text.partition(":")
+    values = [float(v) for v in params.split(",")] if params else []
+    if kind == "hg" and len(values) == 1:
+        return {"type": "hg", "g": values[0]}
+    if kind == "hg2" and len(values) == 3:
+        return {"type": "hg2", "forward_g": values[0], "backward_g": values[1], "forward_weight": values[2]}
+    if kind in ("isotropic", "rayleigh") and not values:
+        return {"type": kind}
+    raise SystemExit(f"--phase: expected isotropic, rayleigh, hg:G or hg2:G1,G2,W, got {text!r}")
+
+
+def phase_value(cos_theta: float) -> float:
+    """4 pi p(cos theta) of PHASE, evaluated directly (MODELS.md conventions)."""
+    def hg(g: float) -> float:
+        g = max(-0.999, min(0.999, g))  # the renderer's clamp
+        return (1 - g * g) / (1 + g * g - 2 * g * cos_theta) ** 1.5
+    kind = PHASE["type"]
+    if kind == "hg":
+        return hg(PHASE["g"])
+    if kind == "hg2":
+        w = PHASE["forward_weight"]
+        return w * hg(PHASE["forward_g"]) + (1 - w) * hg(PHASE["backward_g"])
+    if kind == "rayleigh":
+        return 0.75 * (1 + cos_theta * cos_theta)
+    return 1.0
 
 
 def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.0,
@@ -76,7 +108,7 @@ def street_scene(lamps: int, width: int, height: int, surface_albedo: float = 0.
     return {
         "film": {"width": width, "height": height},
         "camera": {"position": [0.5, 1.6, 0.0], "look_at": [0.0, 3.0, -60.0], "up": [0, 1, 0], "fov_y": 55},
-        "medium": {"sigma_t": SIGMA_T, "albedo": ALBEDO},
+        "medium": {"sigma_t": SIGMA_T, "albedo": ALBEDO, "phase": PHASE},
         "lights": lights,
         "surfaces": surfaces,
     }
@@ -152,6 +184,8 @@ def reference_airlight(scene: dict, origin: np.ndarray, d: np.ndarray, t_end: fl
               axis: np.ndarray = axis, cos_a: float = cos_a, q: float = q) -> float:
             r2 = h2 + (x - b) ** 2
             value = math.exp(-SIGMA_T * (x + math.sqrt(r2))) / r2
+            if PHASE["type"] != "isotropic":  # scattering angle between (p(x) - S) and -d
+                value *= phase_value(float((s - origin - x * d) @ d) / math.sqrt(r2))
             if spot:  # MODELS.md section 2 profile, zero outside the cone
                 ct = ((origin + x * d - s) @ axis) / math.sqrt(r2)
                 value *= 0.0 if ct < cos_a else (1 - q) * (ct - cos_a) / (1 - cos_a) + q
@@ -266,15 +300,20 @@ def main() -> None:
     ap.add_argument("--light-type", choices=("point", "spot", "headlights"), default="point",
                     help="street lamps as point lights (MODELS.md section 1) or spots (section 2), "
                          "or cars' headlights (spots seen along their beams)")
+    ap.add_argument("--phase", default="isotropic",
+                    help="the fog's phase function: isotropic, rayleigh, hg:G (e.g. hg:0.85) or "
+                         "hg2:G_FORWARD,G_BACKWARD,W_FORWARD")
     default_plot = Path(__file__).resolve().parents[1] / "docs/images/bench_airlight.png"
     ap.add_argument("--plot", default=str(default_plot))
     args = ap.parse_args()
+    PHASE.clear()
+    PHASE.update(parse_phase(args.phase))
     rng = np.random.default_rng(1)
     renderers = {b: airlight.Renderer(b) for b in args.backends}
     results: dict[tuple[str, int], dict] = {}
 
     print(f"street of {args.light_type} lights at {args.width}x{args.height}, sigma_t {SIGMA_T}/m, "
-          f"albedo {ALBEDO}; "
+          f"albedo {ALBEDO}, phase {PHASE}; "
           f"error = max relative error over {args.samples} sampled pixels, half of them "
           "in the lamps' halos (cores excluded)")
     base = {b: timed(r, street_scene(0, args.width, args.height))[0] for b, r in renderers.items()}

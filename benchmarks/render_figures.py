@@ -2,7 +2,9 @@
 
     .venv/bin/python benchmarks/render_figures.py [--backend auto]
 
-- foggy_street.png: 16 street lamps in fog (exposure 0.1);
+- foggy_street.png, foggy_street_hg.png: 16 street lamps in isotropic fog
+  (exposure 0.1) and in forward-scattering fog (Henyey-Greenstein g = 0.85,
+  exposure 0.03), both saved by the demo program (airlight-demo);
 - spotlights_crossing.png: the source paper's figure 8, two spotlights
   crossing in media of density 0, 0.01, 0.02 and 0.04 per metre (2 x 2);
 - crane_searchlight.png: a crane's searchlight over the foggy street.
@@ -11,6 +13,9 @@
 from __future__ import annotations
 
 import argparse
+import shutil
+import subprocess
+import sys
 from pathlib import Path
 
 import numpy as np
@@ -18,7 +23,18 @@ from PIL import Image
 
 import airlight
 
-IMAGES = Path(__file__).resolve().parents[1] / "docs" / "images"
+ROOT = Path(__file__).resolve().parents[1]
+IMAGES = ROOT / "docs" / "images"
+
+
+def demo(scene: str, out: Path, exposure: float, backend: str) -> None:
+    """Renders a preset with the demo program (the one next to this Python, else on PATH)."""
+    exe = Path(sys.executable).parent / "airlight-demo"
+    program = str(exe) if exe.exists() else shutil.which("airlight-demo")
+    if program is None:
+        raise SystemExit("airlight-demo not found: run scripts/setup.sh")
+    subprocess.run([program, "--scene", str(ROOT / "scenes" / f"{scene}.json"), "--out", str(out),
+                    "--exposure", str(exposure), "--backend", backend], check=True)
 
 
 def main() -> None:
@@ -26,9 +42,9 @@ def main() -> None:
     ap.add_argument("--backend", default="auto")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
+    demo("foggy_street", IMAGES / "foggy_street.png", 0.1, args.backend)
+    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", 0.03, args.backend)
     with airlight.Renderer(args.backend) as r:
-        street = r.render(airlight.preset("foggy_street"))
-        airlight.save_png(IMAGES / "foggy_street.png", street, exposure=0.1)
         tiles = []
         for density in ("000", "001", "002", "004"):
             radiance = r.render(airlight.preset(f"spotlights_crossing_{density}"), width=320, height=180)
@@ -37,7 +53,8 @@ def main() -> None:
         Image.fromarray(grid).save(IMAGES / "spotlights_crossing.png")
         crane = r.render(airlight.preset("crane_searchlight"))
         airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
-    print(f"wrote {IMAGES}/foggy_street.png, spotlights_crossing.png, crane_searchlight.png")
+    print(f"wrote {IMAGES}/foggy_street.png, foggy_street_hg.png, spotlights_crossing.png, "
+          "crane_searchlight.png")
 
 
 if __name__ == "__main__":
