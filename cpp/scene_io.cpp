@@ -297,11 +297,14 @@ Camera parse_camera(const Obj& o) {
     return c;
 }
 
-// A Henyey-Greenstein asymmetry: a number in (-1, 1), also as a float.
+// A Henyey-Greenstein asymmetry: a number in (-1, 1). One that rounds to
+// +-1 in float32 is kept as the float just inside (rendering clamps |g| to
+// PHASE_G_LIMIT anyway), so that the written scene reloads.
 float read_asymmetry(const Value& v) {
     double g = read_number(v);
+    if (!(g > -1 && g < 1)) fail(Kind::value, v.field, "must be in (-1, 1)");
     float f = static_cast<float>(g);
-    if (!(g > -1 && g < 1 && f > -1 && f < 1)) fail(Kind::value, v.field, "must be in (-1, 1)");
+    if (std::abs(f) >= 1.0f) f = std::copysign(std::nextafter(1.0f, 0.0f), f);
     return f;
 }
 

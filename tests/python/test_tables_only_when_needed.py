@@ -76,3 +76,41 @@ def test_spot_moment_table_only_for_spots_in_fog():
 def test_ray_marched_airlight_builds_no_tail_table():
     scene = base(lights=LAMP, medium=FOG, quality={"airlight": "march", "march_steps": 16})
     assert run([scene])["seen"] == [["surface_glow"]]
+
+
+def fog_with(phase: dict) -> dict:
+    return {**FOG, "phase": phase}
+
+
+HG = {"type": "hg", "g": 0.85}
+
+
+def test_anisotropic_fog_builds_only_its_lobes_tables():
+    """A phase function builds per-lobe slices instead of the isotropic tables: the moment
+    slice for lamps' and spots' airlight, the glow slice only where surfaces receive a
+    lamp's glow; each once per distinct lobe; fog without lamps builds nothing."""
+    assert run([base(medium=fog_with(HG))])["seen"] == [[]]
+    with_glow = ["phase_glow g=0.85", "phase_moments g=0.85"]
+    assert run([base(lights=LAMP, medium=fog_with(HG))])["seen"] == [with_glow]
+    assert run([base(lights=LAMP, medium=fog_with(HG), surfaces=[])])["seen"] == [["phase_moments g=0.85"]]
+    # spots: the moment slice serves their airlight and their glow on surfaces
+    assert run([base(lights=SPOT, medium=fog_with(HG))])["seen"] == [["phase_moments g=0.85"]]
+    # a second frame builds nothing new; another g builds its own slices
+    other = base(lights=LAMP, medium=fog_with({"type": "hg", "g": -0.3}))
+    result = run([base(lights=LAMP, medium=fog_with(HG))] * 2 + [other])
+    assert result["seen"][:2] == [with_glow] * 2
+    assert result["seen"][2] == sorted(with_glow + ["phase_glow g=-0.3", "phase_moments g=-0.3"])
+    stats = result["stats"]
+    assert stats["phase_moments g=0.85"]["bytes"] == 256 * 64 * 4 * 4
+    assert stats["phase_glow g=0.85"]["bytes"] == 256 * 128 * 4
+
+
+def test_two_lobes_rayleigh_and_g0_tables():
+    """HG2 builds one slice per lobe, Rayleigh its own, and HG with g = 0 the isotropic tables."""
+    hg2 = {"type": "hg2", "forward_g": 0.85, "backward_g": -0.3, "forward_weight": 0.9}
+    assert run([base(lights=LAMP, medium=fog_with(hg2), surfaces=[])])["seen"] == [
+        ["phase_moments g=-0.3", "phase_moments g=0.85"]]
+    assert run([base(lights=LAMP, medium=fog_with({"type": "rayleigh"}), surfaces=[])])["seen"] == [
+        ["phase_moments rayleigh"]]
+    assert run([base(lights=LAMP, medium=fog_with({"type": "hg", "g": 0.0}))])["seen"] == [
+        ["airlight_tail", "surface_glow"]]
