@@ -517,7 +517,7 @@ def test_halo_tightens_with_forward_scattering(backend):
 # ---- property-based: any g renders sanely --------------------------------------------------------------
 
 # g values shared with the tests above (each distinct g builds tables once per process)
-_G_SET = [-0.9, -0.5, 0.0, 0.3, 0.85, 0.95, 0.999]
+_G_SET = [-0.999, -0.9, -0.5, 0.0, 0.3, 0.85, 0.95, 0.999]
 _coord = st.floats(-30.0, 30.0, allow_nan=False)
 
 
