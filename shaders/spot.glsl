@@ -184,6 +184,30 @@ float spot_tail(SpotLightGpu s, SpotRay r, float sigma, float tau, bool wall, in
     return Q * (profile - 2.0f * beta * ct * M2 + beta * g * M1);
 }
 
+// The fallback of spot_lobe_airlight in an isotropic medium: 4-point
+// Gauss-Legendre in xi over [xi(lo), xi(hi)] of exp(-u (tan xi - tan xi0))
+// times the profile's local expansion about lo at Delta = xi - xi0
+// (docs/spot_table.md section 3). length_lit = hi - lo, formed by the caller
+// without cancellation.
+float spot_isotropic_quadrature(SpotLightGpu s, SpotRay r, float sigma, float lo, float hi, float length_lit,
+                                float profile0, float ct0, float g0) {
+    float h = r.h;
+    float cv0 = 0.5f * atan(h, lo);
+    float dv = hi >= NO_HIT ? cv0 : 0.5f * atan(h * length_lit, h * h + lo * hi);
+    float u = sigma * h;
+    float s0 = sin(cv0);
+    float beta = s.cone.z;
+    float J = 0.0f;
+    for (int k = 0; k < 4; ++k) {
+        float D = dv * 0.5f * (1.0f + gauss4_node(k));
+        float sD = sin(D);
+        float I = max(profile0 - 2.0f * beta * ct0 * sD * sD + beta * g0 * sin(2.0f * D), 0.0f);
+        float w = D < cv0 ? exp(-u * sD / (s0 * sin(cv0 - D))) : 0.0f;
+        J += 0.5f * gauss4_weight(k) * I * w;
+    }
+    return J * dv;
+}
+
 // The fallback of spot_lobe_airlight for phase lobe `lobe`: 4-point
 // Gauss-Legendre in phi over [phi(lo), phi(hi)] of rho(phi)
 // exp(-u k (tan phi - tan phi0)) times the profile's local expansion about lo
@@ -246,26 +270,10 @@ float spot_lobe_airlight(SpotLightGpu s, SpotRay r, float sigma, float lo, float
         J = tail0 - ratio * tail1;
         mag = mag0 + ratio * mag1;
     }
-    if (!(mag <= 4.0f * abs(J)) && lobe >= 0) {
-        J = spot_lobe_quadrature(s, r, sigma, lo, hi, wall_lo || wall_hi ? hi - lo : clip_length, lobe, profile0, ct0,
-                                 g0);
-    } else if (!(mag <= 4.0f * abs(J))) {
-        float h = r.h;
-        float cv0 = 0.5f * atan(h, lo);
+    if (!(mag <= 4.0f * abs(J))) {
         float length_lit = (wall_lo || wall_hi) ? hi - lo : clip_length;
-        float dv = escapes ? cv0 : 0.5f * atan(h * length_lit, h * h + lo * hi);
-        float u = sigma * h;
-        float s0 = sin(cv0);
-        float beta = s.cone.z;
-        J = 0.0f;
-        for (int k = 0; k < 4; ++k) {
-            float D = dv * 0.5f * (1.0f + gauss4_node(k));
-            float sD = sin(D);
-            float I = max(profile0 - 2.0f * beta * ct0 * sD * sD + beta * g0 * sin(2.0f * D), 0.0f);
-            float w = D < cv0 ? exp(-u * sD / (s0 * sin(cv0 - D))) : 0.0f;
-            J += 0.5f * gauss4_weight(k) * I * w;
-        }
-        J *= dv;
+        J = lobe >= 0 ? spot_lobe_quadrature(s, r, sigma, lo, hi, length_lit, lobe, profile0, ct0, g0)
+                      : spot_isotropic_quadrature(s, r, sigma, lo, hi, length_lit, profile0, ct0, g0);
     }
     return max(J, 0.0f) * exp(arg0 + log(scale));
 }
