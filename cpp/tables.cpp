@@ -216,9 +216,41 @@ Table2D build_glow_table(int width, int height, double k_min, double backward_wi
         for (int iy = 0; iy < t.height; ++iy) {
             const double c = surface_glow_cos_theta(double(iy) / (t.height - 1), T, k_min);
             const double theta_s = std::acos(c);
+            // Phi(g, theta_s) kinks at g = |pi/2 - theta_s| and pi - |pi/2 - theta_s|:
+            // a panel holding a kink is split there, with Q at the new nodes from
+            // the panel's degree-7 interpolant (Q is smooth within a panel).
+            const double off = std::abs(0.5 * kPi - theta_s);
+            const double kinks[2] = {off, kPi - off};
             double sum = 0.0;
-            for (size_t n = 0; n < nodes.size(); ++n) {
-                sum += nodes[n].second * q[n] * clamped_cosine_ring(nodes[n].first, theta_s);
+            for (size_t p = 0; p < nodes.size() / 8; ++p) {
+                const std::pair<double, double>* panel = &nodes[8 * p];
+                const double* qp = &q[8 * p];
+                const double mid = panel[0].first - kGl8x[0] * panel[0].second / kGl8w[0];
+                const double half = panel[0].second / kGl8w[0];
+                double cuts[4] = {mid - half, 0.0, 0.0, mid + half};
+                int count = 1;
+                for (double k : kinks)
+                    if (k > cuts[0] + 1e-12 * half && k < cuts[3] - 1e-12 * half) cuts[count++] = k;
+                if (count == 1) {
+                    for (int j = 0; j < 8; ++j) sum += panel[j].second * qp[j] * clamped_cosine_ring(panel[j].first, theta_s);
+                    continue;
+                }
+                cuts[count] = cuts[3];
+                if (count == 3 && cuts[1] > cuts[2]) std::swap(cuts[1], cuts[2]);
+                for (int piece = 0; piece < count; ++piece) {
+                    const double pm = 0.5 * (cuts[piece] + cuts[piece + 1]), ph = 0.5 * (cuts[piece + 1] - cuts[piece]);
+                    for (int j = 0; j < 8; ++j) {
+                        const double g = pm + ph * kGl8x[j];
+                        double value = 0.0;  // Lagrange interpolation through the panel's nodes
+                        for (int a = 0; a < 8; ++a) {
+                            double basis = 1.0;
+                            for (int b = 0; b < 8; ++b)
+                                if (b != a) basis *= (g - panel[b].first) / (panel[a].first - panel[b].first);
+                            value += basis * qp[a];
+                        }
+                        sum += ph * kGl8w[j] * value * clamped_cosine_ring(g, theta_s);
+                    }
+                }
             }
             t.texels[size_t(iy) * t.width + ix] = float(std::log(sum));
         }
@@ -315,9 +347,11 @@ shader::PhaseLobeGpu phase_lobe_gpu(const PhaseLobe& lobe, float weight) {
     }
     const double g = lobe.g, k = (1.0 - g) / (1.0 + g), root_k = std::sqrt(k);
     gpu.shape = glm::vec4(float(k), float(root_k), float(std::min(k, root_k)), float(1.0 / (1.0 - g)));
-    // The glow's row warp: HG's terminator has a width ~(1 - g) in cos theta_s
-    // however thin the fog (docs/phase_table.md section 6).
-    const double k_min = g > 0.0 ? 2.0 / (1.0 - g) : double(shader::SURFACE_GLOW_K_MIN);
+    // The glow's row warp: an HG lobe's glow turns over a width ~(1 - |g|) in
+    // cos theta_s however thin the fog (docs/phase_table.md sections 6, 9):
+    // the forward lobe's terminator, and for g < 0 the back-scattered light
+    // arriving from just behind the surface's plane.
+    const double k_min = g != 0.0 ? 2.0 / (1.0 - std::abs(g)) : double(shader::SURFACE_GLOW_K_MIN);
     gpu.info = glm::vec4(float(g), 0.0f, float(k_min), weight);
     return gpu;
 }

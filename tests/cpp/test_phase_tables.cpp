@@ -249,11 +249,11 @@ double glow_slice_error(const PhaseLobe& l, int samples, std::mt19937& rng) {
 
 void test_glow_slices_within_budget() {
     std::mt19937 rng(9);
-    // Measured (--analysis): 3.6e-3 at g = -0.9 (near the terminator, T ~ 1),
-    // 1.2e-3 at g = 0.85, <= 7.1e-4 for the others.
+    // Measured (--analysis): 1.8e-3 at g = -0.9 (near theta_s = 90 degrees,
+    // T ~ 1), 1.2e-3 at g = 0.85, <= 6.6e-4 for the others.
     for (const PhaseLobe& l : {hg(-0.9), hg(0.5), hg(0.85), hg(0.95), rayleigh()}) {
         const double e = glow_slice_error(l, 40, rng);
-        CHECK_MSG(e < (l.g < -0.5f ? 5e-3 : 2e-3), label(l) + " glow " + std::to_string(e));
+        CHECK_MSG(e < 3e-3, label(l) + " glow " + std::to_string(e));
     }
 }
 
