@@ -232,7 +232,8 @@ Table2D build_glow_table(int width, int height, double k_min, double backward_wi
                 for (double k : kinks)
                     if (k > cuts[0] + 1e-12 * half && k < cuts[3] - 1e-12 * half) cuts[count++] = k;
                 if (count == 1) {
-                    for (int j = 0; j < 8; ++j) sum += panel[j].second * qp[j] * clamped_cosine_ring(panel[j].first, theta_s);
+                    for (int j = 0; j < 8; ++j)
+                        sum += panel[j].second * qp[j] * clamped_cosine_ring(panel[j].first, theta_s);
                     continue;
                 }
                 cuts[count] = cuts[3];
