@@ -3,11 +3,14 @@
 // scene errors become TypeError/ValueError naming the field.
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
+#include <pybind11/stl.h>
 
 #include <cstring>
 #include <limits>
 #include <memory>
+#include <optional>
 
+#include "airlight/display.hpp"
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
@@ -88,6 +91,25 @@ py::array_t<float> image_to_numpy(airlight::Image&& image) {
     return py::array_t<float>({image.height, image.width, 3}, owned->data(), free_when_done);
 }
 
+// Display settings from the Python arguments (already type-checked by
+// airlight.display); bad values are a ValueError naming the argument.
+airlight::DisplaySettings display_settings(const std::optional<float>& exposure, const std::string& tonemap,
+                                           const std::optional<float>& white) {
+    airlight::DisplaySettings settings;
+    try {
+        settings.curve = airlight::tone_curve_from_name(tonemap, "tonemap");
+        if (exposure) {
+            settings.exposure_mode = airlight::ExposureMode::manual;
+            settings.exposure = *exposure;
+        }
+        settings.white = white;
+        airlight::validate_display_settings(settings, "");
+    } catch (const std::invalid_argument& e) {
+        throw py::value_error(e.what());
+    }
+    return settings;
+}
+
 airlight::Image image_from_numpy(const py::array_t<float, py::array::c_style | py::array::forcecast>& a) {
     if (a.ndim() != 3 || a.shape(2) != 3) throw py::value_error("radiance: expected shape (height, width, 3)");
     airlight::Image image;
@@ -135,6 +157,49 @@ PYBIND11_MODULE(_core, m) {
               std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
               return out;
           });
+
+    m.def(
+        "display",
+        [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, std::optional<float> exposure,
+           const std::string& tonemap, std::optional<float> white) {
+            const airlight::DisplaySettings settings = display_settings(exposure, tonemap, white);
+            const airlight::Image image = image_from_numpy(radiance);
+            std::vector<std::uint8_t> bytes;
+            {
+                py::gil_scoped_release release;
+                bytes = airlight::apply_display(image, settings);
+            }
+            py::array_t<std::uint8_t> out({image.height, image.width, 3});
+            if (!bytes.empty()) std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
+            return out;
+        },
+        py::arg("radiance"), py::arg("exposure"), py::arg("tonemap"), py::arg("white"));
+    m.def(
+        "auto_exposure",
+        [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
+            const airlight::Image image = image_from_numpy(radiance);
+            py::gil_scoped_release release;
+            return airlight::auto_exposure(image);
+        },
+        py::arg("radiance"));
+    m.def(
+        "tone_curve",
+        [](const py::array_t<float, py::array::c_style | py::array::forcecast>& luminance, const std::string& tonemap,
+           std::optional<float> white) {
+            const airlight::DisplaySettings settings = display_settings(std::nullopt, tonemap, white);
+            const float w = settings.white ? *settings.white : airlight::default_white(settings.curve);
+            py::array_t<float> out(std::vector<py::ssize_t>(luminance.shape(), luminance.shape() + luminance.ndim()));
+            const float* src = luminance.data();
+            float* dst = out.mutable_data();
+            for (py::ssize_t i = 0; i < luminance.size(); ++i) {
+                dst[i] = airlight::tone_map_luminance(settings.curve, src[i], w);
+            }
+            return out;
+        },
+        py::arg("luminance"), py::arg("tonemap"), py::arg("white"));
+    m.def("default_white", [](const std::string& tonemap) {
+        return airlight::default_white(display_settings(1.0f, tonemap, {}).curve);
+    });
 
     m.def("tables_built", []() {
         py::dict out;

@@ -20,6 +20,9 @@ using namespace glm;
 #include "layout.glsl"
 #include "phase_math.glsl"
 
+// The display stage's per-pixel math (issue 8): independent of the above.
+#include "display.glsl"
+
 // Which optional features a scene uses; a GL shader variant is compiled per
 // combination, the CPU backend branches on them at run time.
 struct Features {

@@ -31,10 +31,13 @@ from . import _core
 from ._core import BackendUnavailableError
 
 __all__ = [
+    "TONEMAPS",
     "BackendUnavailableError",
     "Renderer",
     "SceneLike",
+    "auto_exposure",
     "available_backends",
+    "display",
     "gl_unavailable_reason",
     "headlights",
     "load_pfm",
@@ -46,6 +49,7 @@ __all__ = [
     "save_png",
     "table_stats",
     "to_srgb8",
+    "tone_curve",
 ]
 
 SceneLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
@@ -177,6 +181,96 @@ def to_srgb8(radiance: np.ndarray, exposure: float = 1.0) -> np.ndarray:
     if not np.isfinite(exposure) or exposure < 0:
         raise ValueError(f"exposure: must be finite and >= 0, got {exposure!r}")
     return _core.to_srgb8(np.asarray(radiance, dtype=np.float32), float(exposure))
+
+
+TONEMAPS = ("linear", "loglog", "reinhard", "filmic")
+"""The tone curves of :func:`display` (see its docstring)."""
+
+
+def _radiance_array(radiance: Any) -> np.ndarray:
+    """``radiance`` as a float32 (height, width, 3) array; TypeError/ValueError naming it."""
+    if not isinstance(radiance, np.ndarray):
+        raise TypeError(f"radiance: expected a numpy array, got {type(radiance).__name__}")
+    if radiance.dtype.kind not in "fiu" or radiance.dtype == np.bool_:
+        raise TypeError(f"radiance: expected a real-valued array, got dtype {radiance.dtype}")
+    if radiance.ndim != 3 or radiance.shape[2] != 3:
+        raise ValueError(f"radiance: expected shape (height, width, 3), got {radiance.shape}")
+    return np.ascontiguousarray(radiance, dtype=np.float32)
+
+
+def _tonemap_args(tonemap: Any, white: Any) -> tuple[str, float | None]:
+    if not isinstance(tonemap, str):
+        raise TypeError(f"tonemap: expected a string, got {type(tonemap).__name__}")
+    if tonemap not in TONEMAPS:
+        raise ValueError(f"tonemap: unknown tone curve {tonemap!r}; expected one of {', '.join(TONEMAPS)}")
+    if white is None:
+        return tonemap, None
+    w = _real("white", white)
+    if w <= 0:
+        raise ValueError(f"white: must be > 0, got {white!r}")
+    return tonemap, w
+
+
+def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: str = "loglog",
+            white: float | None = None) -> np.ndarray:
+    """What the eye sees: 8-bit sRGB (uint8, shape (height, width, 3)) of linear
+    radiance (float (height, width, 3), e.g. from :func:`render`), computed by
+    the native display stage (multithreaded; the same per-pixel code as the GL
+    display pass, ``shaders/display.glsl``).
+
+    Steps: each channel is multiplied by the exposure (NaN, negative and
+    infinite values count as 0); the tone curve is applied to the Rec. 709
+    luminance ``Y = 0.2126 R + 0.7152 G + 0.0722 B`` and the pixel scaled by
+    ``f(Y) / Y`` (colours keep their chromaticity; channels above 1 clip);
+    then the sRGB OETF (IEC 61966-2-1) and rounding to 8 bits.
+
+    - ``exposure``: ``"auto"`` (default) maps the log-average luminance of
+      the pixels with finite ``Y > 0`` to the key 0.18 (Reinhard et al. 2002);
+      see :func:`auto_exposure`. A number >= 0 multiplies the radiance.
+    - ``tonemap``, the curve ``f`` of exposed luminance ``L`` with white point
+      ``W`` (the exposed luminance shown as display value 1):
+      ``"linear"`` ``L / W`` (W = 1 by default: like :func:`to_srgb8`);
+      ``"loglog"`` (default), the source paper's double logarithm,
+      ``ln(1 + ln(1 + L)) / ln(1 + ln(1 + W))``, W = 100;
+      ``"reinhard"``, extended Reinhard (2002), ``L (1 + L / W^2) / (1 + L)``, W = 16;
+      ``"filmic"``, the ACES fit of Narkowicz (2015),
+      ``x (2.51 x + 0.03) / (x (2.43 x + 0.59) + 0.14)`` with ``x = 7.2439 L / W``,
+      W = 7.2439 (the published curve). Every curve maps 0 to 0, is
+      non-decreasing, and is clipped to [0, 1]; see
+      ``docs/images/tone_curves.png``.
+    - ``white``: ``W``, a number > 0; ``None`` for the curve's default.
+
+    Bad arguments raise ``TypeError``/``ValueError`` naming the argument
+    (``"exposure: must be >= 0, got -1"``).
+    """
+    image = _radiance_array(radiance)
+    tonemap, w = _tonemap_args(tonemap, white)
+    if isinstance(exposure, str):
+        if exposure != "auto":
+            raise ValueError(f"exposure: must be 'auto' or a number >= 0, got {exposure!r}")
+        manual = None
+    else:
+        manual = _real("exposure", exposure)
+        if manual < 0:
+            raise ValueError(f"exposure: must be >= 0, got {exposure!r}")
+    return _core.display(image, manual, tonemap, w)
+
+
+def auto_exposure(radiance: np.ndarray) -> float:
+    """The exposure ``display(radiance, exposure="auto")`` uses: 0.18 divided by
+    the log-average Rec. 709 luminance ``exp(mean(ln Y))`` over the pixels with
+    finite ``Y > 0`` (black, negative, NaN and infinite pixels are ignored); 1.0
+    when there is none."""
+    return float(_core.auto_exposure(_radiance_array(radiance)))
+
+
+def tone_curve(luminance: Any, tonemap: str = "loglog", white: float | None = None) -> np.ndarray:
+    """The tone curve of :func:`display` applied to exposed luminance values
+    (any shape, float32 result in [0, 1], before sRGB encoding); ``white=None``
+    is the curve's default white point."""
+    tonemap, w = _tonemap_args(tonemap, white)
+    values = np.asarray(luminance, dtype=np.float32)
+    return np.asarray(_core.tone_curve(np.ascontiguousarray(values), tonemap, w), dtype=np.float32)
 
 
 def save_png(path: str | os.PathLike[str], radiance: np.ndarray, exposure: float = 1.0) -> None:

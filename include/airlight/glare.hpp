@@ -1,0 +1,133 @@
+// Physically based glare of the eye (issue 8, MODELS.md section 5): the
+// Fraunhofer point spread function of the pupil (optionally obstructed by
+// eyelashes), per wavelength, combined through the CIE 1931 colour matching
+// functions into one kernel per linear sRGB channel, resampled onto the
+// image's angular pixel grid by integrating the PSF over each pixel, and
+// applied to linear radiance by FFT convolution. Derivation and measured
+// numbers: docs/glare.md.
+#pragma once
+
+#include <array>
+#include <complex>
+#include <vector>
+
+#include "airlight/renderer.hpp"
+
+namespace airlight {
+
+// The field that names the pupil diameter in error messages.
+inline constexpr const char* kPupilDiameterField = "display.glare.pupil_diameter";
+
+// Throws std::invalid_argument("display.glare.pupil_diameter: must be in [1, 9] mm (got X)")
+// unless 1 <= diameter_mm <= 9 (NaN included).
+void validate_pupil_diameter(double diameter_mm);
+
+// Light-adapted pupil diameter (mm) from the adaptation luminance (cd/m^2),
+// Moon & Spencer 1944 (JOSA 34, 319): D = 4.9 - 3 tanh(0.4 log10 B) with B in
+// millilamberts (B = L pi / 10 for L in cd/m^2); ranges over 1.9 to 7.9 mm.
+// Throws std::invalid_argument naming "display.glare.adaptation_luminance"
+// unless the luminance is finite and > 0.
+double pupil_diameter_from_luminance(double luminance_cd_m2);
+
+// Angle (radians) subtended by the central pixel of a pinhole camera with the
+// full vertical field of view fov_y_deg over `height` rows:
+// 2 tan(fov_y / 2) / height (fov_y / height is a few percent smaller at wide fovs).
+double camera_pixel_angle(double fov_y_deg, int height);
+
+// CIE 1931 2-degree colour matching functions x, y, z at a wavelength (nm):
+// the multi-lobe Gaussian fit of Wyman, Sloan & Shirley 2013, "Simple
+// Analytic Approximations to the CIE XYZ Color Matching Functions", JCGT 2(2).
+std::array<double, 3> cie1931_xyz(double wavelength_nm);
+
+// Linear sRGB (D65) from CIE XYZ (IEC 61966-2-1 matrix).
+std::array<double, 3> xyz_to_linear_srgb(const std::array<double, 3>& xyz);
+
+struct GlareOptions {
+    double pupil_diameter_mm = 4.0;  // [1, 9]
+    bool eyelashes = false;
+    int eyelash_count = 5;            // thin opaque strips across the upper pupil
+    double eyelash_width_mm = 0.08;   // strip width in the pupil plane
+    int grid_size = 1024;             // aperture / FFT grid N (power of two, >= 64)
+    int max_kernel_radius = 64;       // the kernel is (2r + 1)^2 pixels, r <= this
+    double wavelength_step_nm = 5.0;  // spectral integration step over 380-780 nm
+};
+
+// The pupil's transmission on an N x N grid of spacing dx (m): cell (ix, iy)
+// is centred at ((ix - N/2) dx, (iy - N/2) dx), y up; values are the covered
+// fraction of each cell (anti-aliased edges), 0 under an eyelash.
+struct PupilAperture {
+    int n = 0;
+    double dx = 0.0;
+    std::vector<double> transmission;  // n * n, row iy, column ix
+};
+PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx);
+
+// |FT(aperture)|^2 on the FFT's frequency grid, zero frequency at index
+// (n/2, n/2), each value the fraction of the light through the pupil that
+// falls in its cell (normalised by the pupil's area, so the grid holds a
+// little less than 1: the rest, about (2/3) dx / D, is diffracted beyond the
+// grid's angular range lambda / (2 dx)). At wavelength lambda cell k sits
+// at angle theta = lambda (k - n/2) / (n dx): the same array serves every
+// wavelength (Fraunhofer diffraction of a wavelength-independent aperture).
+struct PupilSpectrum {
+    int n = 0;
+    double dx = 0.0;
+    std::vector<double> power;  // n * n
+    double angle_step(double wavelength_m) const { return wavelength_m / (n * dx); }
+};
+PupilSpectrum pupil_power_spectrum(const PupilAperture& aperture);
+
+// One kernel per linear sRGB channel, (2 radius + 1)^2 values each, row 0 on
+// top, the centre at (radius, radius); each channel sums to 1.
+struct GlareKernel {
+    int radius = 0;
+    double pixel_angle = 0.0;  // radians
+    std::array<std::vector<double>, 3> weights;
+    // PSF energy inside the kernel before normalising (1 - truncation). Normalising keeps the central pixel's
+    // exact integral and scales the off-centre weights up by the missing energy, which leaves the centre.
+    std::array<double, 3> captured{};
+    std::array<double, 3> negative_clamped{};  // |negative weight| removed (XYZ->RGB), relative to the sum
+    double grid_dx = 0.0;                      // aperture sampling used (m)
+    int size() const { return 2 * radius + 1; }
+    double at(int c, int row, int col) const { return weights[c][static_cast<size_t>(row) * size() + col]; }
+    double centre(int c) const { return at(c, radius, radius); }
+};
+
+// Monochromatic kernel at wavelength_m (all three channels equal). Each
+// kernel value is the integral of the PSF over the pixel's angular square
+// (pixel_angle radians on a side), so when the Airy core is smaller than a
+// pixel the central pixel holds the core's energy.
+GlareKernel glare_kernel_mono(const GlareOptions& options, double pixel_angle, double wavelength_m);
+
+// Spectral kernel: the PSF of an equal-energy white point source, integrated
+// over 380-780 nm weighted by the CIE 1931 functions, converted to linear
+// sRGB, negative weights clamped to 0, each channel normalised to sum 1.
+GlareKernel glare_kernel_rgb(const GlareOptions& options, double pixel_angle);
+
+// Convolution of linear RGB radiance by the kernel, per channel, with zero
+// padding (light falling beyond the border is lost, none wraps around).
+// threads <= 0: hardware concurrency.
+Image convolve_glare_fft(const Image& image, const GlareKernel& kernel, int threads = 0);
+Image convolve_glare_direct(const Image& image, const GlareKernel& kernel, int threads = 0);
+
+// Bound on how much glare can change any pixel of this image, per channel
+// maximum of v_max (1 - k_centre): the kernel moves at most the fraction
+// 1 - k_centre of a pixel's light elsewhere, and gathers into a pixel at most
+// v_max times the kernel's off-centre weight.
+double glare_change_bound(const Image& image, const GlareKernel& kernel);
+
+// False when skipping the glare changes no pixel by more than
+// tolerance * display_white (the bound above); then leave the image as is.
+bool glare_needed(const Image& image, const GlareKernel& kernel, double display_white, double tolerance = 1e-3);
+
+// Internal pieces, exposed for the tests.
+namespace detail {
+// In-place iterative radix-2 FFT; size must be a power of two. Forward:
+// X_k = sum_n x_n exp(-2 pi i k n / N); inverse includes the 1/N.
+void fft(std::vector<std::complex<double>>& data, bool inverse);
+// 2-D FFT of a row-major ny x nx array (both powers of two), rows then columns.
+void fft2d(std::vector<std::complex<double>>& data, int nx, int ny, bool inverse, int threads = 1);
+int next_pow2(int n);
+}  // namespace detail
+
+}  // namespace airlight
