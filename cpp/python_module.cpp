@@ -11,6 +11,7 @@
 #include <optional>
 
 #include "airlight/display.hpp"
+#include "airlight/glare.hpp"
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
@@ -197,6 +198,28 @@ PYBIND11_MODULE(_core, m) {
             return out;
         },
         py::arg("luminance"), py::arg("tonemap"), py::arg("white"));
+    m.def(
+        "glare",
+        [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, double fov_y,
+           double pupil_diameter, bool eyelashes) {
+            const airlight::Image image = image_from_numpy(radiance);
+            airlight::Image out;
+            try {
+                airlight::GlareOptions options;
+                options.pupil_diameter_mm = pupil_diameter;
+                options.eyelashes = eyelashes;
+                py::gil_scoped_release release;
+                const double pixel_angle = airlight::camera_pixel_angle(fov_y, std::max(image.height, 1));
+                const airlight::GlareKernel kernel = airlight::glare_kernel_rgb(options, pixel_angle);
+                out = airlight::convolve_glare_fft(image, kernel);
+            } catch (const std::invalid_argument& e) {
+                throw py::value_error(e.what());
+            }
+            py::array_t<float> result({out.height, out.width, 3});
+            if (!out.rgb.empty()) std::memcpy(result.mutable_data(), out.rgb.data(), out.rgb.size() * sizeof(float));
+            return result;
+        },
+        py::arg("radiance"), py::arg("fov_y"), py::arg("pupil_diameter"), py::arg("eyelashes"));
     m.def("default_white", [](const std::string& tonemap) {
         return airlight::default_white(display_settings(1.0f, tonemap, {}).curve);
     });

@@ -39,6 +39,7 @@ __all__ = [
     "available_backends",
     "display",
     "gl_unavailable_reason",
+    "glare",
     "headlights",
     "load_pfm",
     "load_scene",
@@ -271,6 +272,28 @@ def tone_curve(luminance: Any, tonemap: str = "loglog", white: float | None = No
     tonemap, w = _tonemap_args(tonemap, white)
     values = np.asarray(luminance, dtype=np.float32)
     return np.asarray(_core.tone_curve(np.ascontiguousarray(values), tonemap, w), dtype=np.float32)
+
+
+def glare(radiance: np.ndarray, *, fov_y: float, pupil_diameter: float = 4.0,
+          eyelashes: bool = False) -> np.ndarray:
+    """The eye's diffraction glare applied to linear radiance (float32, same
+    shape): each channel convolved with the point spread function of a pupil
+    of ``pupil_diameter`` mm (1 to 9; optionally with eyelashes across its
+    upper part), the Fraunhofer pattern of the aperture per wavelength over
+    380-780 nm weighted by the CIE 1931 colour matching functions and
+    integrated over each pixel, so the Airy core is honest whether it is
+    smaller or larger than a pixel. ``fov_y`` (degrees) is the camera's
+    vertical field of view, which sets the angle per pixel. The kernel sums to
+    1 per channel: glare moves light, it does not create it (docs/glare.md).
+    Work in progress (issue 8): no GL pass and no scene-format key yet.
+    """
+    image = _radiance_array(radiance)
+    fov = _real("fov_y", fov_y)
+    if not 0 < fov < 180:
+        raise ValueError(f"fov_y: must be in (0, 180) degrees, got {fov_y!r}")
+    if not isinstance(eyelashes, bool):
+        raise TypeError(f"eyelashes: expected a bool, got {type(eyelashes).__name__}")
+    return np.asarray(_core.glare(image, fov, _real("pupil_diameter", pupil_diameter), eyelashes))
 
 
 def save_png(path: str | os.PathLike[str], radiance: np.ndarray, exposure: float = 1.0) -> None:
