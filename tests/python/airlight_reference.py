@@ -387,8 +387,12 @@ def glow_unit(sigma_t: float, dist: float, cos_theta_s: float, nodes: int = GLOW
     return _glow_unit_phase_cached(float(sigma_t), float(dist), cos_s, int(nodes), phase)
 
 
-@functools.lru_cache(maxsize=100_000)
-def _glow_unit_cached(sigma_t: float, dist: float, cos_s: float, nodes: int) -> float:
+def _polar_glow(sigma_t: float, dist: float, cos_s: float, nodes: int, ray_log: Any,
+                lobe_widths: Sequence[float] = ()) -> float:
+    """The polar reduction of glow_unit: alpha (the angle of the ray from the light
+    direction) in pieces cut where the lit azimuth changes form, graded towards the light
+    in thick fog and, for each phase lobe of width w, at alpha ~ w and pi - alpha ~ w;
+    ray_log(b, h) is the log airlight of the ray per unit sigma_s I."""
     theta = math.acos(cos_s)
     sin_s = math.sin(theta)
     lo, hi = max(0.0, theta - math.pi / 2), min(math.pi, theta + math.pi / 2)
@@ -396,35 +400,10 @@ def _glow_unit_cached(sigma_t: float, dist: float, cos_s: float, nodes: int) -> 
     optical = sigma_t * dist
     if optical > 1.0 and lo == 0.0:  # the glow concentrates near the light direction
         breaks += [p for p in (1.0 / math.sqrt(optical), 4.0 / math.sqrt(optical)) if lo < p < hi]
-    edges = [lo] + sorted(set(breaks)) + [hi]
-    s, w = _smoothstep_gauss(nodes)
-    total = 0.0
-    for a, c in zip(edges[:-1], edges[1:]):
-        for si, wi in zip(s, w):
-            alpha = a + (c - a) * si
-            weight = _lit_azimuth_weight(alpha, cos_s, sin_s) * math.sin(alpha)
-            if weight <= 0.0:
-                continue
-            lg = airlight_log(sigma_t, 1.0, 1.0, dist * math.cos(alpha), dist * math.sin(alpha))
-            total += wi * (c - a) * weight * math.exp(lg)
-    return total
-
-
-@functools.lru_cache(maxsize=100_000)
-def _glow_unit_phase_cached(sigma_t: float, dist: float, cos_s: float, nodes: int, phase: Phase) -> float:
-    """glow_unit for an anisotropic phase: the same polar reduction, each ray's airlight by
-    phase_reference's xi rule, the alpha pieces also graded towards the lobes."""
-    theta = math.acos(cos_s)
-    sin_s = math.sin(theta)
-    lo, hi = max(0.0, theta - math.pi / 2), min(math.pi, theta + math.pi / 2)
-    breaks = [p for p in (math.pi / 2 - theta, 1.5 * math.pi - theta) if lo < p < hi]
-    optical = sigma_t * dist
-    if optical > 1.0 and lo == 0.0:
-        breaks += [p for p in (1.0 / math.sqrt(optical), 4.0 / math.sqrt(optical)) if lo < p < hi]
-    for _, w in phase.widths():  # a lobe of width w shapes the glow at alpha ~ w and pi - alpha ~ w
+    for width in lobe_widths:
         k = -6
-        while w * 2.0 ** k < math.pi:
-            a = w * 2.0 ** k
+        while width * 2.0 ** k < math.pi:
+            a = width * 2.0 ** k
             breaks += [p for p in (a, math.pi - a) if lo < p < hi]
             k += 1
     edges = [lo] + sorted(set(breaks)) + [hi]
@@ -436,10 +415,21 @@ def _glow_unit_phase_cached(sigma_t: float, dist: float, cos_s: float, nodes: in
             weight = _lit_azimuth_weight(alpha, cos_s, sin_s) * math.sin(alpha)
             if weight <= 0.0:
                 continue
-            lg = airlight_xi_log(sigma_t, 1.0, 1.0, dist * math.cos(alpha), dist * math.sin(alpha),
-                                 phase=phase)
-            total += wi * (c - a) * weight * math.exp(lg)
+            total += wi * (c - a) * weight * math.exp(ray_log(dist * math.cos(alpha), dist * math.sin(alpha)))
     return total
+
+
+@functools.lru_cache(maxsize=100_000)
+def _glow_unit_cached(sigma_t: float, dist: float, cos_s: float, nodes: int) -> float:
+    return _polar_glow(sigma_t, dist, cos_s, nodes, lambda b, h: airlight_log(sigma_t, 1.0, 1.0, b, h))
+
+
+@functools.lru_cache(maxsize=100_000)
+def _glow_unit_phase_cached(sigma_t: float, dist: float, cos_s: float, nodes: int, phase: Phase) -> float:
+    """glow_unit for an anisotropic phase: each ray's airlight by phase_reference's xi rule."""
+    return _polar_glow(sigma_t, dist, cos_s, nodes,
+                       lambda b, h: airlight_xi_log(sigma_t, 1.0, 1.0, b, h, phase=phase),
+                       [w for _, w in phase.widths()])
 
 
 def glow_hemisphere_bruteforce(sigma_t: float, dist: float, cos_theta_s: float, n_polar: int = 32,

@@ -45,7 +45,7 @@ from airlight_reference import DIM_FRACTION, get_renderer, glow_unit, light, mak
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from image_checks import finite_non_negative as _finite_non_negative
-from scipy.integrate import nquad, quad
+from scipy.integrate import quad
 from spot_reference import (
     GLOW_NODES,
     Phase,
@@ -63,6 +63,7 @@ from spot_reference import (
     spot_compare,
     spot_geometry,
     spot_glow_unit,
+    spot_glow_volume_nquad,
     spot_pixel_radiance,
     spot_samples,
     spot_unit_logs,
@@ -180,51 +181,6 @@ def point_glow_unit(sigma: float, dist: float, cos_s: float, phase: Any) -> floa
         breaks += [1.0 / math.sqrt(sigma * dist), 1.0 / (sigma * dist)]
     edges = [lo] + sorted(p for p in set(breaks) if lo < p < hi) + [hi]
     return _quad_pieces(f, edges, eps=1e-10)
-
-
-def volume_nquad(sigma: float, position: Any, sp: Spot, point: Any, normal: Any, phase: Any,
-                 theta_range: tuple[float, float], uniform: bool = False, eps: float = 1e-9) -> float:
-    """The glow's volume integral with a phase (per unit sigma_s I0 / (4 pi)) over the
-    directions from the lamp at angles theta_range from the axis, by scipy nquad in
-    spherical coordinates about the lamp (polar axis a): bounded wherever P is not in the
-    region. cos(scattering angle) = e.(P - y)/|P - y|, e the direction from the lamp.
-    `uniform`: profile 1 instead of I / I0."""
-    s, p, n, a = (np.asarray(v, dtype=np.float64) for v in (position, point, normal, sp.axis))
-    b1 = _unit(np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0]))
-    b2 = np.cross(a, b1)
-    w = p - s
-    dist = float(np.linalg.norm(w))
-    wa, w1, w2, na, n1, n2, nw = w @ a, w @ b1, w @ b2, n @ a, n @ b1, n @ b2, n @ w
-
-    def f(r: float, ph: float, th: float) -> float:
-        ct, st = math.cos(th), math.sin(th)
-        e1, e2 = st * math.cos(ph), st * math.sin(ph)
-        dx, dy, dz = r * ct - wa, r * e1 - w1, r * e2 - w2  # y - P
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        nd = na * dx + n1 * dy + n2 * dz
-        if nd <= 0.0:
-            return 0.0
-        prof = 1.0 if uniform else (1.0 - sp.edge) * (ct - sp.cos_a) / (1.0 - sp.cos_a) + sp.edge
-        cos_t = -(ct * dx + e1 * dy + e2 * dz) / d
-        return prof * phase(cos_t) * st * math.exp(-sigma * (r + d - dist)) * nd / d ** 3
-
-    def along(ph: float, th: float) -> float:
-        e = np.array([math.cos(th), math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph)])
-        en = e[0] * na + e[1] * n1 + e[2] * n2
-        closest = max(float(e @ [wa, w1, w2]), 0.0)
-        breaks = {closest}
-        if en != 0.0 and nw / en > 0.0:
-            breaks.add(nw / en)
-        edges = [0.0, *sorted(breaks)]
-        total = sum(quad(f, lo, hi, args=(ph, th), epsabs=0.0, epsrel=eps, limit=200)[0]
-                    for lo, hi in zip(edges[:-1], edges[1:]) if hi > lo)
-        return total + quad(f, edges[-1], math.inf, args=(ph, th), epsabs=0.0, epsrel=eps, limit=200)[0]
-
-    opts = {"epsabs": 0.0, "epsrel": eps, "limit": 200}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        value = nquad(along, [[0.0, 2.0 * math.pi], list(theta_range)], opts=[opts, opts])[0]
-    return value * math.exp(-sigma * dist)
 
 
 def _random_rays(seed: int, n: int, spread: float = 1.0):
@@ -445,7 +401,7 @@ def test_reference_glow_matches_volume_nquad_outside_the_beam(case, name):
     sigma, position, axis, cone, edge, point, normal = NQUAD_CASES[case]
     sp = make_spot(axis, cone, edge)
     ph = CHECKED[name]
-    expect = volume_nquad(sigma, position, sp, point, normal, ph, (0.0, math.radians(cone)))
+    expect = spot_glow_volume_nquad(sigma, position, sp, point, normal, ph, (0.0, math.radians(cone)))
     assert expect > 0
     assert spot_glow_unit(sigma, position, sp, point, normal, phase=ph) == pytest.approx(expect, rel=1e-8)
 
@@ -462,7 +418,8 @@ def test_reference_glow_matches_volume_nquad_in_the_beam(name):
     assert float(direction_profile(sp, position, np.asarray(point, dtype=np.float64))) > 0
     rel = position - np.asarray(point)
     dist = float(np.linalg.norm(rel))
-    outside = volume_nquad(sigma, position, sp, point, UP, ph, (math.radians(cone), math.pi), uniform=True)
+    outside = spot_glow_volume_nquad(sigma, position, sp, point, UP, ph, (math.radians(cone), math.pi),
+                                     uniform=True)
     expect = point_glow_unit(sigma, dist, float(rel @ UP) / dist, ph) - outside
     assert spot_glow_unit(sigma, position, sp, point, UP, phase=ph) == pytest.approx(expect, rel=1e-8)
 

@@ -40,7 +40,6 @@ import copy
 import json
 import math
 import time
-import warnings
 from dataclasses import dataclass
 from typing import Any
 
@@ -62,11 +61,10 @@ from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
 from image_checks import finite_non_negative as _finite_non_negative
 from image_checks import no_jumps as _no_jumps
-from scipy.integrate import nquad, quad
 from scipy.ndimage import distance_transform_edt
 from spot_reference import (
     GLOW_NODES,
-    Spot,
+    ISOTROPIC,
     SpotScene,
     direction_profile,
     glow_directions,
@@ -80,6 +78,7 @@ from spot_reference import (
     spot_glow_irradiance,
     spot_glow_radiance,
     spot_glow_unit,
+    spot_glow_volume_nquad,
     spot_pixel_radiance,
     spot_unit_logs,
 )
@@ -192,47 +191,6 @@ def test_reference_ray_integrals_are_the_spot_airlight(name):
         f"{expect[np.argmax(err)]:.10e}")
 
 
-def _volume_nquad(sigma: float, position: Any, sp: Spot, point: Any, normal: Any,
-                  theta_range: tuple[float, float], uniform: bool = False, eps: float = 1e-8) -> float:
-    """The glow's volume integral (per unit sigma_s I0 / (4 pi)) over the directions from the
-    lamp with angle theta_range from the axis, by scipy nquad in spherical coordinates
-    about the lamp (polar axis a; the r^2 of the volume element cancels 1 / |y - S|^2):
-    bounded wherever P is not in the region. `uniform`: profile 1 instead of I / I0."""
-    s, p, n, a = (np.asarray(v, dtype=np.float64) for v in (position, point, normal, sp.axis))
-    b1 = _unit(np.cross(a, [1.0, 0.0, 0.0] if abs(a[0]) < 0.9 else [0.0, 1.0, 0.0]))
-    b2 = np.cross(a, b1)
-    w = p - s
-    dist = float(np.linalg.norm(w))
-    wa, w1, w2, na, n1, n2, nw = w @ a, w @ b1, w @ b2, n @ a, n @ b1, n @ b2, n @ w
-
-    def f(r: float, ph: float, th: float) -> float:
-        ct, st = math.cos(th), math.sin(th)
-        dx, dy, dz = r * ct - wa, r * st * math.cos(ph) - w1, r * st * math.sin(ph) - w2
-        d = math.sqrt(dx * dx + dy * dy + dz * dz)
-        nd = na * dx + n1 * dy + n2 * dz  # n.(y - P)
-        if nd <= 0.0:
-            return 0.0
-        prof = 1.0 if uniform else (1.0 - sp.edge) * (ct - sp.cos_a) / (1.0 - sp.cos_a) + sp.edge
-        return prof * st * math.exp(-sigma * (r + d - dist)) * nd / d ** 3
-
-    def along(ph: float, th: float) -> float:
-        e = np.array([math.cos(th), math.sin(th) * math.cos(ph), math.sin(th) * math.sin(ph)])
-        en = e[0] * na + e[1] * n1 + e[2] * n2
-        breaks = {max(float(e @ [wa, w1, w2]), 0.0)}  # closest approach to P; the surface's plane
-        if en != 0.0 and nw / en > 0.0:
-            breaks.add(nw / en)
-        edges = [0.0, *sorted(breaks)]
-        total = sum(quad(f, lo, hi, args=(ph, th), epsabs=0.0, epsrel=eps, limit=200)[0]
-                    for lo, hi in zip(edges[:-1], edges[1:]) if hi > lo)
-        return total + quad(f, edges[-1], math.inf, args=(ph, th), epsabs=0.0, epsrel=eps, limit=200)[0]
-
-    opts = {"epsabs": 0.0, "epsrel": eps, "limit": 200}
-    with warnings.catch_warnings():
-        warnings.simplefilter("ignore")
-        value = nquad(along, [[0.0, 2.0 * math.pi], list(theta_range)], opts=[opts, opts])[0]
-    return value * math.exp(-sigma * dist)
-
-
 NQUAD_OUTSIDE = {  # P outside the beam: the integrand is bounded
     "beside_the_beam": (0.1, (0, 3, 0), _unit([0.3, -1, 0.1]), 30.0, 0.5, (4, 0, 0), UP),
     "lamp_behind_the_surface": (0.2, (0, -1, 0), _unit([0.2, 1, 0]), 40.0, 0.5, (3, 0, 0), UP),
@@ -246,7 +204,8 @@ def test_reference_matches_volume_nquad_outside_the_beam(name):
     spherical coordinates about the lamp (polar axis: the spot's axis), within 1e-7."""
     sigma, position, axis, cone, edge, point, normal = NQUAD_OUTSIDE[name]
     sp = make_spot(axis, cone, edge)
-    expect = _volume_nquad(sigma, position, sp, point, normal, (0.0, math.radians(cone)))
+    expect = spot_glow_volume_nquad(sigma, position, sp, point, normal, ISOTROPIC,
+                                    (0.0, math.radians(cone)), eps=1e-8)
     assert expect > 0
     assert spot_glow_unit(sigma, position, sp, point, normal) == pytest.approx(expect, rel=1e-7)
 
@@ -262,7 +221,8 @@ def test_reference_matches_volume_nquad_in_the_beam(sigma_t, point):
     assert float(direction_profile(sp, position, np.asarray(point, dtype=np.float64))) > 0
     rel = position - np.asarray(point)
     dist = float(np.linalg.norm(rel))
-    outside = _volume_nquad(sigma_t, position, sp, point, UP, (math.radians(cone), math.pi), uniform=True)
+    outside = spot_glow_volume_nquad(sigma_t, position, sp, point, UP, ISOTROPIC,
+                                     (math.radians(cone), math.pi), uniform=True, eps=1e-8)
     expect = 4.0 * math.pi * glow_unit(sigma_t, dist, float(rel @ UP) / dist, nodes=48) - outside
     assert spot_glow_unit(sigma_t, position, sp, point, UP) == pytest.approx(expect, rel=1e-7)
 
