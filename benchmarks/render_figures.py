@@ -7,7 +7,15 @@
   exposure 0.03), both saved by the demo program (airlight-demo);
 - spotlights_crossing.png: the source paper's figure 8, two spotlights
   crossing in media of density 0, 0.01, 0.02 and 0.04 per metre (2 x 2);
-- crane_searchlight.png: a crane's searchlight over the foggy street.
+- crane_searchlight.png: a crane's searchlight over the foggy street;
+- foggy_street_eye.png: the foggy street as the eye sees it (issue 8): the
+  display stage with automatic exposure, the double-logarithmic curve and the
+  glare of a 4 mm pupil with eyelashes, by the demo;
+- approaching_car.png: the headlight experiment (airlight-demo --sequence
+  approaching-car), the middle of 7 frames from 2 km to 20 m side by side.
+
+The first figures use the linear curve (``--tonemap linear``) with the
+exposures above, as before the display stage existed.
 """
 
 from __future__ import annotations
@@ -16,6 +24,7 @@ import argparse
 import shutil
 import subprocess
 import sys
+import tempfile
 from pathlib import Path
 
 import numpy as np
@@ -27,14 +36,30 @@ ROOT = Path(__file__).resolve().parents[1]
 IMAGES = ROOT / "docs" / "images"
 
 
-def demo(scene: str, out: Path, exposure: float, backend: str) -> None:
+def demo(scene: str, out: Path, backend: str, *flags: str) -> None:
     """Renders a preset with the demo program (the one next to this Python, else on PATH)."""
     exe = Path(sys.executable).parent / "airlight-demo"
     program = str(exe) if exe.exists() else shutil.which("airlight-demo")
     if program is None:
         raise SystemExit("airlight-demo not found: run scripts/setup.sh")
     subprocess.run([program, "--scene", str(ROOT / "scenes" / f"{scene}.json"), "--out", str(out),
-                    "--exposure", str(exposure), "--backend", backend], check=True)
+                    "--backend", backend, *flags], check=True)
+
+
+def approaching_car_strip(backend: str, out: Path) -> None:
+    """The headlight experiment's frames (80 x 32 pixels around the car, enlarged 3 times),
+    side by side from 2 km (left) to 20 m (right)."""
+    with tempfile.TemporaryDirectory() as tmp:
+        demo("approaching_car", Path(tmp), backend, "--sequence", "approaching-car", "--frames", "7")
+        tiles = []
+        for path in sorted(Path(tmp).glob("frame_*.png")):
+            with Image.open(path) as png:
+                frame = np.asarray(png.convert("RGB"))
+            h, w = frame.shape[:2]
+            crop = frame[h // 2 - 16:h // 2 + 16, w // 2 - 40:w // 2 + 40]
+            tiles.append(np.asarray(Image.fromarray(crop).resize((240, 96), Image.NEAREST)))
+            tiles.append(np.full((96, 4, 3), 60, np.uint8))
+    Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 
 def main() -> None:
@@ -42,8 +67,13 @@ def main() -> None:
     ap.add_argument("--backend", default="auto")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
-    demo("foggy_street", IMAGES / "foggy_street.png", 0.1, args.backend)
-    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", 0.03, args.backend)
+    demo("foggy_street", IMAGES / "foggy_street.png", args.backend, "--exposure", "0.1",
+         "--tonemap", "linear")
+    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", args.backend, "--exposure", "0.03",
+         "--tonemap", "linear")
+    demo("foggy_street", IMAGES / "foggy_street_eye.png", args.backend, "--exposure", "auto", "--tonemap",
+         "loglog", "--glare", "--pupil", "4", "--eyelashes")
+    approaching_car_strip(args.backend, IMAGES / "approaching_car.png")
     with airlight.Renderer(args.backend) as r:
         tiles = []
         for density in ("000", "001", "002", "004"):
@@ -54,7 +84,7 @@ def main() -> None:
         crane = r.render(airlight.preset("crane_searchlight"))
         airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
     print(f"wrote {IMAGES}/foggy_street.png, foggy_street_hg.png, spotlights_crossing.png, "
-          "crane_searchlight.png")
+          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png")
 
 
 if __name__ == "__main__":

@@ -2,13 +2,37 @@
 // the same shared per-pixel code (shaders/*.glsl).
 #pragma once
 
+#include <cstdint>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "airlight/renderer.hpp"
 #include "frame_data.hpp"
 
 namespace airlight {
+
+struct GlareKernel;  // include/airlight/glare.hpp
+
+// One run of the GL display pass (issue 8). cpp/display_stage.cpp resolves
+// the exposure and decides whether glare is needed (the same decisions as on
+// the CPU); the GPU does the glare convolution, the tone curve and the sRGB
+// encoding (shaders/display.glsl's display_pixel).
+struct GlDisplayJob {
+    const Image* linear = nullptr;       // linear radiance, row 0 on top
+    float exposure = 1.0f;               // resolved exposure, >= 0
+    int curve = 0;                       // shader::TONE_*
+    float white = 1.0f;                  // > 0
+    const GlareKernel* glare = nullptr;  // null: no glare
+};
+
+// What the GL display pass returns: RGB bytes, row 0 on top, as
+// apply_display; and the time of each part (after glFinish), in ms.
+struct GlDisplayOutput {
+    std::vector<std::uint8_t> srgb8;
+    double glare_ms = 0.0;
+    double tone_ms = 0.0;
+};
 
 class CpuBackend {
 public:
@@ -23,6 +47,11 @@ public:
     GlBackend(const GlBackend&) = delete;
     GlBackend& operator=(const GlBackend&) = delete;
     void render(const FrameData& data, Image& out);
+    // The display stage on the GPU (see GlDisplayJob).
+    void display(const GlDisplayJob& job, GlDisplayOutput& out);
+    // The glare convolution of the display pass alone (fp32 FFT on the GPU),
+    // read back as linear radiance: compare with convolve_glare_fft.
+    void glare_convolve(const Image& in, const GlareKernel& kernel, Image& out);
 
     struct State;
 

@@ -1,11 +1,17 @@
-// airlight-demo: renders a scene file headless to PNG (8-bit sRGB) or PFM
-// (float radiance). Bad input exits non-zero with a one-line message.
+// airlight-demo: renders a scene file headless to PNG (8-bit sRGB through the
+// display stage: exposure, glare, tone curve) or PFM (float radiance), or the
+// approaching-car headlight sequence (issue 8). Bad input exits non-zero with
+// a one-line message.
 #include <chrono>
+#include <cmath>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
+#include <filesystem>
 #include <string>
+#include <vector>
 
+#include "airlight/display.hpp"
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
@@ -20,13 +26,25 @@ namespace {
 
 const char* kUsage =
     "usage: airlight-demo --scene S.json --out F.png|F.pfm [--backend auto|gl|cpu]\n"
-    "                     [--width W --height H] [--exposure E] [--window]\n";
+    "                     [--width W --height H] [--window]\n"
+    "  display stage (PNG; overrides the scene's \"display\" object):\n"
+    "                     [--exposure E|auto] [--tonemap linear|loglog|reinhard|filmic]\n"
+    "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
+    "  the headlight experiment (a car approaching from --from to --to metres,\n"
+    "  the camera tracking it; frames DIR/frame_NN_DDDDm.png):\n"
+    "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n";
 
 struct Options {
-    std::string scene, out, backend = "auto";
+    std::string scene, out, backend = "auto", sequence;
     int width = 0, height = 0;
-    float exposure = 1.0f;
     bool window = false;
+    // Display overrides (empty: the scene's).
+    std::string exposure, tonemap, pupil;
+    float white = 0.0f;
+    int glare = -1;  // -1: the scene's; 0 off; 1 on
+    bool eyelashes = false;
+    int frames = 12;
+    double from = 2000.0, to = 20.0;
 };
 
 [[noreturn]] void fail(const std::string& message) {
@@ -34,13 +52,24 @@ struct Options {
     std::exit(2);
 }
 
-int parse_int(const std::string& flag, const char* text) {
+int parse_int(const std::string& flag, const char* text, int lo, int hi) {
     char* end = nullptr;
     const long value = std::strtol(text, &end, 10);
-    if (end == text || *end != '\0' || value < 1 || value > 16384) {
-        fail(flag + " must be an integer in 1..16384, got '" + text + "'");
+    if (end == text || *end != '\0' || value < lo || value > hi) {
+        fail(flag + " must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" + text +
+             "'");
     }
     return int(value);
+}
+
+// A finite number in [lo, hi].
+double parse_number(const std::string& flag, const char* text, double lo, double hi, const char* what) {
+    char* end = nullptr;
+    const double value = std::strtod(text, &end);
+    if (end == text || *end != '\0' || !(value >= lo && value <= hi)) {
+        fail(flag + " must be " + what + ", got '" + text + "'");
+    }
+    return value;
 }
 
 Options parse_args(int argc, char** argv) {
@@ -55,6 +84,14 @@ Options parse_args(int argc, char** argv) {
             o.window = true;
             continue;
         }
+        if (arg == "--glare" || arg == "--no-glare") {
+            o.glare = arg == "--glare" ? 1 : 0;
+            continue;
+        }
+        if (arg == "--eyelashes") {
+            o.eyelashes = true;
+            continue;
+        }
         if (i + 1 >= argc) fail("missing value after " + arg);
         const char* value = argv[++i];
         if (arg == "--scene")
@@ -64,16 +101,34 @@ Options parse_args(int argc, char** argv) {
         else if (arg == "--backend")
             o.backend = value;
         else if (arg == "--width")
-            o.width = parse_int(arg, value);
+            o.width = parse_int(arg, value, 1, 16384);
         else if (arg == "--height")
-            o.height = parse_int(arg, value);
+            o.height = parse_int(arg, value, 1, 16384);
         else if (arg == "--exposure") {
-            char* end = nullptr;
-            o.exposure = std::strtof(value, &end);
-            if (end == value || *end != '\0' || !(o.exposure >= 0.0f) || o.exposure > 1e30f) {
-                fail(std::string("--exposure must be a finite number >= 0, got '") + value + "'");
+            o.exposure = value;
+            if (o.exposure != "auto") parse_number(arg, value, 0.0, 1e30, "'auto' or a finite number >= 0");
+        } else if (arg == "--tonemap") {
+            o.tonemap = value;
+            try {
+                airlight::tone_curve_from_name(o.tonemap, "--tonemap");
+            } catch (const std::invalid_argument& e) {
+                fail(e.what());
             }
-        } else
+        } else if (arg == "--white")
+            o.white = float(parse_number(arg, value, 1e-30, 1e30, "a number > 0"));
+        else if (arg == "--pupil") {
+            o.pupil = value;
+            if (o.pupil != "auto") parse_number(arg, value, 1.0, 9.0, "'auto' or a diameter in [1, 9] mm");
+        } else if (arg == "--sequence") {
+            o.sequence = value;
+            if (o.sequence != "approaching-car") fail("--sequence must be approaching-car, got '" + o.sequence + "'");
+        } else if (arg == "--frames")
+            o.frames = parse_int(arg, value, 2, 1000);
+        else if (arg == "--from")
+            o.from = parse_number(arg, value, 1.0, 1e5, "a distance in [1, 1e5] m");
+        else if (arg == "--to")
+            o.to = parse_number(arg, value, 1.0, 1e5, "a distance in [1, 1e5] m");
+        else
             fail("unknown option " + arg + " (see --help)");
     }
     if (o.scene.empty()) fail("--scene is required (see --help)");
@@ -81,6 +136,7 @@ Options parse_args(int argc, char** argv) {
     if (o.backend != "auto" && o.backend != "gl" && o.backend != "cpu") {
         fail("--backend must be auto, gl or cpu, got '" + o.backend + "'");
     }
+    if (!o.sequence.empty() && !(o.to < o.from)) fail("--to must be less than --from");
     return o;
 }
 
@@ -88,12 +144,95 @@ bool ends_with(const std::string& s, const std::string& suffix) {
     return s.size() >= suffix.size() && s.compare(s.size() - suffix.size(), suffix.size(), suffix) == 0;
 }
 
+// The scene's display settings with the command line's overrides.
+airlight::DisplaySettings display_settings(const airlight::Scene& scene, const Options& o) {
+    airlight::DisplaySettings d = scene.display;
+    if (o.exposure == "auto") {
+        d.exposure_mode = airlight::ExposureMode::automatic;
+    } else if (!o.exposure.empty()) {
+        d.exposure_mode = airlight::ExposureMode::manual;
+        d.exposure = std::strtof(o.exposure.c_str(), nullptr);
+    }
+    if (!o.tonemap.empty()) d.curve = airlight::tone_curve_from_name(o.tonemap, "--tonemap");
+    if (o.white > 0.0f) d.white = o.white;
+    if (o.glare >= 0) d.glare.enabled = o.glare == 1;
+    if (!o.pupil.empty()) {
+        d.glare.enabled = o.glare != 0;
+        if (o.pupil == "auto")
+            d.glare.pupil_diameter_mm.reset();
+        else
+            d.glare.pupil_diameter_mm = std::strtod(o.pupil.c_str(), nullptr);
+    }
+    if (o.eyelashes) {
+        d.glare.enabled = o.glare != 0;
+        d.glare.eyelashes = true;
+    }
+    return d;
+}
+
+void print_report(const std::string& path, const airlight::Image& image, airlight::Backend backend, double render_ms,
+                  const airlight::DisplayReport* r) {
+    std::printf("airlight-demo: %s %dx%d (%s backend, %.1f ms", path.c_str(), image.width, image.height,
+                airlight::backend_name(backend), render_ms);
+    if (r != nullptr) {
+        std::printf("; display: exposure %.4g, glare %s", double(r->exposure), r->glare.c_str());
+        if (r->glare != "off") std::printf(" (pupil %.2f mm, %lld sources)", r->pupil_diameter_mm, r->glare_sources);
+        std::printf(", %.1f ms", r->glare_ms + r->tone_ms);
+    }
+    std::printf(")\n");
+}
+
+// The headlight experiment of the source paper (MODELS.md section 5): a car's
+// two headlights (spots 1.5 m apart, 0.65 m high, aimed at the camera)
+// approach along the road from `from` to `to` metres (distances spaced
+// evenly in log), the camera (1.2 m high) tracking the midpoint between them.
+// Everything else (film, field of view, medium, road, display with the
+// pupil) comes from the scene file: scenes/approaching_car.json sets a 1 mm
+// pupil and 0.34 mrad pixels (half the resolution angle 1.22 lambda / D), so
+// the lamps, one spot at 2 km, become an ellipse and then two.
+int run_sequence(airlight::Scene scene, const Options& o, airlight::Backend backend) {
+    using namespace airlight;
+    const DisplaySettings settings = display_settings(scene, o);
+    std::error_code error;
+    std::filesystem::create_directories(o.out, error);
+    if (error) fail("--out: cannot create directory '" + o.out + "': " + error.message());
+    Renderer renderer(backend);
+    const glm::vec3 camera(0.0f, 1.2f, 0.0f);
+    for (int k = 0; k < o.frames; ++k) {
+        const double d = o.from * std::pow(o.to / o.from, double(k) / double(o.frames - 1));
+        Scene frame = scene;
+        frame.camera.position = camera;
+        frame.camera.look_at = glm::vec3(0.0f, 0.65f, -float(d));
+        frame.camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
+        for (float side : {-0.75f, 0.75f}) {
+            SpotLight lamp;
+            lamp.position = glm::vec3(side, 0.65f, -float(d));
+            lamp.direction = glm::vec3(0.0f, -0.02f, 1.0f);
+            lamp.intensity = glm::vec3(2000.0f, 1900.0f, 1700.0f);
+            lamp.cone_angle_degrees = 25.0f;
+            lamp.edge = 0.3f;
+            lamp.radius = 0.09f;
+            frame.spot_lights.push_back(lamp);
+        }
+        const auto start = std::chrono::steady_clock::now();
+        const Image image = renderer.render(frame);
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
+        char name[64];
+        std::snprintf(name, sizeof name, "/frame_%02d_%04dm.png", k, int(std::lround(d)));
+        const std::string path = o.out + name;
+        write_png(path, shown.width, shown.height, shown.srgb8);
+        print_report(path, image, backend, ms, &shown.report);
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     using namespace airlight;
     const Options o = parse_args(argc, argv);
-    if (!o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm")) {
+    if (o.sequence.empty() && !o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm")) {
         fail("--out must end in .png or .pfm, got '" + o.out + "'");
     }
     Scene scene;
@@ -116,9 +255,14 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
     }
     try {
+        if (!o.sequence.empty()) return run_sequence(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
-            return run_window(scene, backend, o.exposure);
+            const float exposure =
+                o.exposure.empty() || o.exposure == "auto"
+                    ? (scene.display.exposure_mode == ExposureMode::manual ? scene.display.exposure : 1.0f)
+                    : std::strtof(o.exposure.c_str(), nullptr);
+            return run_window(scene, backend, exposure);
 #else
             fail("--window needs a build with GLFW");
 #endif
@@ -127,12 +271,14 @@ int main(int argc, char** argv) {
         const auto start = std::chrono::steady_clock::now();
         const Image image = renderer.render(scene);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-        if (ends_with(o.out, ".pfm"))
+        if (ends_with(o.out, ".pfm")) {
             write_pfm(o.out, image);
-        else
-            write_png(o.out, image.width, image.height, to_srgb8(image, o.exposure));
-        std::printf("airlight-demo: %s %dx%d (%s backend, %.1f ms)\n", o.out.c_str(), image.width, image.height,
-                    backend_name(backend), ms);
+            print_report(o.out, image, backend, ms, nullptr);
+        } else {
+            const DisplayImage shown = renderer.display(image, display_settings(scene, o), scene.camera.fov_y_degrees);
+            write_png(o.out, shown.width, shown.height, shown.srgb8);
+            print_report(o.out, image, backend, ms, &shown.report);
+        }
     } catch (const std::exception& e) {
         fail(e.what());
     }

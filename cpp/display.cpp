@@ -9,13 +9,12 @@
 #include <stdexcept>
 #include <thread>
 
+#include "display_stage.hpp"
 #include "shader_cpp.hpp"
 
 namespace airlight {
 
-namespace {
-
-int shader_curve_id(ToneCurve curve) {
+int tone_curve_shader_id(ToneCurve curve) {
     switch (curve) {
         case ToneCurve::linear:
             return shader::TONE_LINEAR;
@@ -28,6 +27,8 @@ int shader_curve_id(ToneCurve curve) {
     }
     return -1;
 }
+
+namespace {
 
 void check_image(const Image& image) {
     if (image.width < 0 || image.height < 0 || image.rgb.size() != size_t(image.width) * size_t(image.height) * 3) {
@@ -90,7 +91,7 @@ float default_white(ToneCurve curve) {
 }
 
 void validate_display_settings(const DisplaySettings& settings, const std::string& prefix) {
-    if (shader_curve_id(settings.curve) < 0) {
+    if (tone_curve_shader_id(settings.curve) < 0) {
         throw std::invalid_argument(prefix + "tonemap: unknown tone curve (enum value " +
                                     std::to_string(int(settings.curve)) + ")");
     }
@@ -145,7 +146,7 @@ float resolve_exposure(const Image& image, const DisplaySettings& settings, int 
 }
 
 float tone_map_luminance(ToneCurve curve, float luminance, float white) {
-    return shader::tone_curve(shader_curve_id(curve), luminance, white);
+    return shader::tone_curve(tone_curve_shader_id(curve), luminance, white);
 }
 
 std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettings& settings, int threads) {
@@ -153,7 +154,7 @@ std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettin
     check_image(linear);
     const float exposure = resolve_exposure(linear, settings, threads);
     const float white = settings.white ? *settings.white : default_white(settings.curve);
-    const int curve = shader_curve_id(settings.curve);
+    const int curve = tone_curve_shader_id(settings.curve);
     std::vector<std::uint8_t> out(linear.rgb.size());
     const size_t row_floats = size_t(linear.width) * 3;
     for_each_row(linear.height, threads, [&](int row) {

@@ -14,5 +14,7 @@ bool gl_backend_available(std::string* reason) {
 GlBackend::GlBackend() { throw BackendUnavailable("airlight: GL backend unavailable: built without EGL/OpenGL"); }
 GlBackend::~GlBackend() = default;
 void GlBackend::render(const FrameData&, Image&) {}
+void GlBackend::display(const GlDisplayJob&, GlDisplayOutput&) {}
+void GlBackend::glare_convolve(const Image&, const GlareKernel&, Image&) {}
 
 }  // namespace airlight

@@ -4,8 +4,13 @@
 
 #include <algorithm>
 #include <cmath>
+#include <list>
+#include <map>
+#include <memory>
+#include <mutex>
 #include <sstream>
 #include <stdexcept>
+#include <string>
 #include <thread>
 
 namespace airlight {
@@ -216,6 +221,216 @@ double conserve_energy(std::vector<double>& w, int radius) {
     return sum;
 }
 
+// ---------------------------------------------------------------------------
+// FFT: mixed-radix (4, 2, 3, 5) Stockham autosort, decimation in frequency
+// (Stockham 1966; formulation of Van Loan, "Computational Frameworks for the
+// Fast Fourier Transform", 1992, section 1.7). A stage of radix p on a
+// sub-transform of length L = p m with stride s maps x to y by
+//   y[q + s (p j + t)] = w^(j t) sum_r x[q + s (j + r m)] e^(-2 pi i r t / p),  w = e^(-2 pi i / L),
+// for j < m, q < s, then recurses on length m with stride s p (x, y swapped).
+// No bit reversal; the loop over q is contiguous. Batched: every element is
+// a run of `batch` complex values (several columns transformed together).
+// Twiddles are precomputed per stage with cos/sin of the exact angle.
+// ---------------------------------------------------------------------------
+
+using cd = std::complex<double>;
+
+struct FftStage {
+    int radix, m, s;    // sub-length radix * m, stride s
+    size_t twiddle_at;  // w^(j t) at twiddle_at + j (radix - 1) + t - 1
+};
+
+struct FftPlan {
+    int n = 1;
+    std::vector<FftStage> stages;
+    std::vector<cd> twiddles;
+};
+
+// The product without std::complex's NaN recovery (which blocks vectorisation).
+inline cd cmul(cd a, cd b) {
+    return {a.real() * b.real() - a.imag() * b.imag(), a.real() * b.imag() + a.imag() * b.real()};
+}
+template <bool Inv>
+inline cd twiddle(cd w) {
+    return Inv ? std::conj(w) : w;
+}
+// Multiplies by -i (forward) or +i (inverse).
+template <bool Inv>
+inline cd rot(cd a) {
+    return Inv ? cd(-a.imag(), a.real()) : cd(a.imag(), -a.real());
+}
+
+template <bool Inv>
+void stage2(const cd* x, cd* y, int m, size_t run, const cd* tw) {
+    for (int j = 0; j < m; ++j) {
+        const cd w1 = twiddle<Inv>(tw[j]);
+        const cd *x0 = x + run * j, *x1 = x + run * (j + m);
+        cd *y0 = y + run * (2 * j), *y1 = y0 + run;
+        for (size_t q = 0; q < run; ++q) {
+            const cd a = x0[q], b = x1[q];
+            y0[q] = a + b;
+            y1[q] = cmul(a - b, w1);
+        }
+    }
+}
+
+template <bool Inv>
+void stage4(const cd* x, cd* y, int m, size_t run, const cd* tw) {
+    for (int j = 0; j < m; ++j) {
+        const cd w1 = twiddle<Inv>(tw[3 * j]), w2 = twiddle<Inv>(tw[3 * j + 1]), w3 = twiddle<Inv>(tw[3 * j + 2]);
+        const cd *x0 = x + run * j, *x1 = x + run * (j + m), *x2 = x + run * (j + 2 * m), *x3 = x + run * (j + 3 * m);
+        cd *y0 = y + run * (4 * j), *y1 = y0 + run, *y2 = y1 + run, *y3 = y2 + run;
+        for (size_t q = 0; q < run; ++q) {
+            const cd b0 = x0[q] + x2[q], b1 = x0[q] - x2[q], b2 = x1[q] + x3[q], b3 = rot<Inv>(x1[q] - x3[q]);
+            y0[q] = b0 + b2;
+            y1[q] = cmul(b1 + b3, w1);
+            y2[q] = cmul(b0 - b2, w2);
+            y3[q] = cmul(b1 - b3, w3);
+        }
+    }
+}
+
+template <bool Inv>
+void stage3(const cd* x, cd* y, int m, size_t run, const cd* tw) {
+    const double s3 = (Inv ? 1.0 : -1.0) * 0.86602540378443864676;  // sin(+-2 pi / 3)
+    for (int j = 0; j < m; ++j) {
+        const cd w1 = twiddle<Inv>(tw[2 * j]), w2 = twiddle<Inv>(tw[2 * j + 1]);
+        const cd *x0 = x + run * j, *x1 = x + run * (j + m), *x2 = x + run * (j + 2 * m);
+        cd *y0 = y + run * (3 * j), *y1 = y0 + run, *y2 = y1 + run;
+        for (size_t q = 0; q < run; ++q) {
+            const cd a0 = x0[q], s = x1[q] + x2[q], d = x1[q] - x2[q];
+            const cd c = a0 - 0.5 * s, e(-s3 * d.imag(), s3 * d.real());  // e = i sin d
+            y0[q] = a0 + s;
+            y1[q] = cmul(c + e, w1);
+            y2[q] = cmul(c - e, w2);
+        }
+    }
+}
+
+template <bool Inv>
+void stage5(const cd* x, cd* y, int m, size_t run, const cd* tw) {
+    const double c1 = 0.30901699437494742410, c2 = -0.80901699437494742410;  // cos(2 pi / 5), cos(4 pi / 5)
+    const double sg = Inv ? 1.0 : -1.0;
+    const double s1 = sg * 0.95105651629515357212, s2 = sg * 0.58778525229247312917;  // sin(2 pi / 5), sin(4 pi / 5)
+    for (int j = 0; j < m; ++j) {
+        const cd* w = tw + 4 * j;
+        const cd w1 = twiddle<Inv>(w[0]), w2 = twiddle<Inv>(w[1]), w3 = twiddle<Inv>(w[2]), w4 = twiddle<Inv>(w[3]);
+        const cd *x0 = x + run * j, *x1 = x + run * (j + m), *x2 = x + run * (j + 2 * m), *x3 = x + run * (j + 3 * m),
+                 *x4 = x + run * (j + 4 * m);
+        cd *y0 = y + run * (5 * j), *y1 = y0 + run, *y2 = y1 + run, *y3 = y2 + run, *y4 = y3 + run;
+        for (size_t q = 0; q < run; ++q) {
+            const cd a0 = x0[q], t1 = x1[q] + x4[q], t2 = x2[q] + x3[q], t3 = x1[q] - x4[q], t4 = x2[q] - x3[q];
+            const cd b1 = a0 + c1 * t1 + c2 * t2, b2 = a0 + c2 * t1 + c1 * t2;
+            const cd u1 = s1 * t3 + s2 * t4, u2 = s2 * t3 - s1 * t4;  // times i below
+            const cd e1(-u1.imag(), u1.real()), e2(-u2.imag(), u2.real());
+            y0[q] = a0 + t1 + t2;
+            y1[q] = cmul(b1 + e1, w1);
+            y4[q] = cmul(b1 - e1, w4);
+            y2[q] = cmul(b2 + e2, w2);
+            y3[q] = cmul(b2 - e2, w3);
+        }
+    }
+}
+
+FftPlan make_plan(int n) {
+    FftPlan plan;
+    plan.n = n;
+    int rest = n, s = 1;
+    while (rest > 1) {
+        int p = 0;
+        if (rest % 4 == 0) {
+            p = 4;
+        } else if (rest % 2 == 0) {
+            p = 2;
+        } else if (rest % 3 == 0) {
+            p = 3;
+        } else if (rest % 5 == 0) {
+            p = 5;
+        } else {
+            throw std::invalid_argument("fft: size must be a product of 2, 3 and 5 (got " + std::to_string(n) + ")");
+        }
+        const int m = rest / p;
+        plan.stages.push_back({p, m, s, plan.twiddles.size()});
+        for (int j = 0; j < m; ++j)
+            for (int t = 1; t < p; ++t) {
+                const long long e = (static_cast<long long>(j) * t) % rest;
+                const double a = -2.0 * kPi * double(e) / double(rest);
+                plan.twiddles.emplace_back(std::cos(a), std::sin(a));
+            }
+        rest = m;
+        s *= p;
+    }
+    return plan;
+}
+
+// Plans are built once per size and kept (a few kB each); the map is only touched under the mutex.
+const FftPlan& get_plan(int n) {
+    static std::mutex mutex;
+    static std::map<int, std::unique_ptr<FftPlan>> plans;
+    std::lock_guard<std::mutex> lock(mutex);
+    std::unique_ptr<FftPlan>& slot = plans[n];
+    if (!slot) {
+        try {
+            slot = std::make_unique<FftPlan>(make_plan(n));
+        } catch (...) {
+            plans.erase(n);
+            throw;
+        }
+    }
+    return *slot;
+}
+
+// Unnormalised transform of `batch` interleaved sequences: element k of sequence b at data[k * batch + b].
+// work holds n * batch values. The result is left in data.
+template <bool Inv>
+void run_plan(const FftPlan& plan, cd* data, cd* work, size_t batch) {
+    cd *x = data, *y = work;
+    for (const FftStage& st : plan.stages) {
+        const size_t run = size_t(st.s) * batch;
+        const cd* tw = plan.twiddles.data() + st.twiddle_at;
+        switch (st.radix) {
+            case 4:
+                stage4<Inv>(x, y, st.m, run, tw);
+                break;
+            case 2:
+                stage2<Inv>(x, y, st.m, run, tw);
+                break;
+            case 3:
+                stage3<Inv>(x, y, st.m, run, tw);
+                break;
+            default:
+                stage5<Inv>(x, y, st.m, run, tw);
+                break;
+        }
+        std::swap(x, y);
+    }
+    if (x != data) std::copy(x, x + size_t(plan.n) * batch, data);
+}
+
+void run_plan(const FftPlan& plan, cd* data, cd* work, size_t batch, bool inverse) {
+    if (inverse) {
+        run_plan<true>(plan, data, work, batch);
+    } else {
+        run_plan<false>(plan, data, work, batch);
+    }
+}
+
+// Columns transformed together: a block of kColumnBlock columns (py x 8 x 16 bytes, ~150 kB for 1125 rows,
+// twice with the work buffer) stays in L2 through all the stages.
+constexpr int kColumnBlock = 8;
+
+// Transforms columns [x0, x1) of a row-major ny x nx array, kColumnBlock at a time.
+void fft_column_range(std::complex<double>* data, int nx, int ny, int x0, int x1, bool inverse) {
+    const FftPlan& plan = get_plan(ny);
+    std::vector<cd> block(size_t(ny) * kColumnBlock), work(block.size());
+    for (int xb = x0; xb < x1; xb += kColumnBlock) {
+        const int bw = std::min(kColumnBlock, x1 - xb);
+        for (int y = 0; y < ny; ++y) std::copy_n(data + size_t(y) * nx + xb, bw, block.data() + size_t(y) * bw);
+        run_plan(plan, block.data(), work.data(), size_t(bw), inverse);
+        for (int y = 0; y < ny; ++y) std::copy_n(block.data() + size_t(y) * bw, bw, data + size_t(y) * nx + xb);
+    }
+}
+
 }  // namespace
 
 namespace detail {
@@ -226,34 +441,33 @@ int next_pow2(int n) {
     return p;
 }
 
+bool is_fft_size(int n) {
+    if (n < 1) return false;
+    for (int p : {2, 3, 5})
+        while (n % p == 0) n /= p;
+    return n == 1;
+}
+
+int next_fft_size(int n) {
+    if (n <= 1) return 1;
+    // Smallest 2^a 3^b 5^c >= n: enumerate the products of powers of 5 and 3, then double up to n.
+    long long best = static_cast<long long>(next_pow2(n));
+    for (long long p5 = 1; p5 < 2LL * n; p5 *= 5)
+        for (long long p35 = p5; p35 < 2LL * n; p35 *= 3) {
+            long long v = p35;
+            while (v < n) v *= 2;
+            best = std::min(best, v);
+        }
+    return static_cast<int>(best);
+}
+
 void fft(std::vector<std::complex<double>>& data, bool inverse) {
     const size_t n = data.size();
     if (n <= 1) return;
-    if ((n & (n - 1)) != 0) throw std::invalid_argument("fft: size must be a power of two");
-    for (size_t i = 1, j = 0; i < n; ++i) {
-        size_t bit = n >> 1;
-        for (; j & bit; bit >>= 1) j ^= bit;
-        j ^= bit;
-        if (i < j) std::swap(data[i], data[j]);
-    }
-    const double sign = inverse ? 1.0 : -1.0;
-    for (size_t len = 2; len <= n; len <<= 1) {
-        const size_t half = len / 2;
-        // Twiddles computed directly (not by repeated multiplication) to keep the error near 1e-16.
-        std::vector<std::complex<double>> tw(half);
-        for (size_t k = 0; k < half; ++k) {
-            const double a = sign * 2.0 * kPi * double(k) / double(len);
-            tw[k] = {std::cos(a), std::sin(a)};
-        }
-        for (size_t i = 0; i < n; i += len) {
-            for (size_t k = 0; k < half; ++k) {
-                const std::complex<double> u = data[i + k];
-                const std::complex<double> t = data[i + k + half] * tw[k];
-                data[i + k] = u + t;
-                data[i + k + half] = u - t;
-            }
-        }
-    }
+    if (n > size_t(1) << 30) throw std::invalid_argument("fft: size too large");
+    const FftPlan& plan = get_plan(static_cast<int>(n));
+    std::vector<cd> work(n);
+    run_plan(plan, data.data(), work.data(), 1, inverse);
     if (inverse) {
         const double s = 1.0 / double(n);
         for (auto& z : data) z *= s;
@@ -261,25 +475,22 @@ void fft(std::vector<std::complex<double>>& data, bool inverse) {
 }
 
 void fft2d(std::vector<std::complex<double>>& data, int nx, int ny, bool inverse, int threads) {
-    if (!is_pow2(nx) || !is_pow2(ny) || data.size() != size_t(nx) * ny)
-        throw std::invalid_argument("fft2d: sizes must be powers of two matching the data");
+    if (!is_fft_size(nx) || !is_fft_size(ny) || data.size() != size_t(nx) * ny)
+        throw std::invalid_argument("fft2d: sizes must be products of 2, 3 and 5 matching the data");
     threads = resolve_threads(threads);
+    const FftPlan& row_plan = get_plan(nx);
     parallel_for(ny, threads, [&](int begin, int end) {
-        std::vector<std::complex<double>> line(nx);
-        for (int y = begin; y < end; ++y) {
-            std::copy(data.begin() + size_t(y) * nx, data.begin() + size_t(y + 1) * nx, line.begin());
-            fft(line, inverse);
-            std::copy(line.begin(), line.end(), data.begin() + size_t(y) * nx);
-        }
+        std::vector<cd> work(nx);
+        for (int y = begin; y < end; ++y) run_plan(row_plan, data.data() + size_t(y) * nx, work.data(), 1, inverse);
     });
-    parallel_for(nx, threads, [&](int begin, int end) {
-        std::vector<std::complex<double>> line(ny);
-        for (int x = begin; x < end; ++x) {
-            for (int y = 0; y < ny; ++y) line[y] = data[size_t(y) * nx + x];
-            fft(line, inverse);
-            for (int y = 0; y < ny; ++y) data[size_t(y) * nx + x] = line[y];
-        }
+    const int blocks = (nx + kColumnBlock - 1) / kColumnBlock;
+    parallel_for(blocks, threads, [&](int begin, int end) {
+        fft_column_range(data.data(), nx, ny, begin * kColumnBlock, std::min(nx, end * kColumnBlock), inverse);
     });
+    if (inverse) {
+        const double s = 1.0 / (double(nx) * ny);
+        for (auto& z : data) z *= s;
+    }
 }
 
 }  // namespace detail
@@ -515,59 +726,255 @@ GlareKernel glare_kernel_rgb(const GlareOptions& options, double pixel_angle) {
     return std::move(k);
 }
 
-Image convolve_glare_fft(const Image& image, const GlareKernel& kernel, int threads) {
-    const int w = image.width, h = image.height, r = kernel.radius, ks = kernel.size();
-    if (w < 1 || h < 1 || image.rgb.size() != size_t(w) * h * 3)
-        throw std::invalid_argument("glare: image size does not match its data");
-    threads = resolve_threads(threads);
-    const int px = detail::next_pow2(w + 2 * r), py = detail::next_pow2(h + 2 * r);
-    const size_t total = size_t(px) * py;
-    Image out{w, h, std::vector<float>(size_t(w) * h * 3, 0.0f)};
-    // Two real channels per complex transform: z = a + i b. With the spectra A, B of a, b recovered from Z by
-    // conjugate symmetry, the product A Ka + i B Kb transforms back to conv(a, ka) + i conv(b, kb).
-    // Kernels: ka + i kb likewise, with ka centred at index (0, 0) (wrapped).
-    const int pairs[2][2] = {{0, 1}, {2, -1}};
-    std::vector<std::complex<double>> z(total), kz(total);
-    for (const auto& pair : pairs) {
-        const int ca = pair[0], cb = pair[1];
-        std::fill(z.begin(), z.end(), std::complex<double>(0.0, 0.0));
-        std::fill(kz.begin(), kz.end(), std::complex<double>(0.0, 0.0));
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const float* p = &image.rgb[(size_t(y) * w + x) * 3];
-                z[size_t(y) * px + x] = {double(p[ca]), cb >= 0 ? double(p[cb]) : 0.0};
+namespace {
+
+// The kernel's spectrum on a px x py grid, per channel py rows x (px / 2 + 1) columns (the other columns follow
+// by the conjugate symmetry of a real kernel's transform), scaled by 1 / (px py): the inverse transforms of the
+// convolution are left unnormalised.
+struct KernelSpectrum {
+    int px = 0, py = 0, radius = 0;
+    std::array<std::vector<double>, 3> weights;  // the kernel it was made from (the cache key)
+    std::array<std::vector<cd>, 3> spectrum;
+    size_t bytes() const { return 3 * spectrum[0].size() * sizeof(cd); }
+};
+
+// Forward FFTs of `count` real rows of length px, two per complex transform (real-input trick, e.g. Press et
+// al., Numerical Recipes, section 12.3): with Z = FFT(a + i b), the half spectra of the real rows a and b are
+// A_k = (Z_k + conj Z_(px-k)) / 2 and B_k = (Z_k - conj Z_(px-k)) / (2 i), k = 0 .. px / 2.
+// fill(t, dst) writes real row t at dst[0], dst[2], ... (zeroed beforehand); dest(t) is where its
+// px / 2 + 1 coefficients go.
+template <class Fill, class Dest>
+void forward_real_rows(int count, int px, int threads, const Fill& fill, const Dest& dest) {
+    const FftPlan& plan = get_plan(px);
+    const int hx = px / 2 + 1;
+    parallel_for((count + 1) / 2, threads, [&](int begin, int end) {
+        std::vector<cd> z(px), work(px);
+        double* line = reinterpret_cast<double*>(z.data());  // std::complex<double> is an array of two doubles
+        for (int pair = begin; pair < end; ++pair) {
+            const int ta = 2 * pair, tb = ta + 1;
+            std::fill(z.begin(), z.end(), cd(0.0, 0.0));
+            fill(ta, line);
+            if (tb < count) fill(tb, line + 1);
+            run_plan<false>(plan, z.data(), work.data(), 1);
+            cd* a = dest(ta);
+            cd* b = tb < count ? dest(tb) : nullptr;
+            for (int k = 0; k < hx; ++k) {
+                const cd zk = z[k], zm = std::conj(z[k == 0 ? 0 : px - k]);
+                a[k] = 0.5 * (zk + zm);
+                if (b) b[k] = cd(0.5 * (zk.imag() - zm.imag()), -0.5 * (zk.real() - zm.real()));  // (zk - zm) / 2i
             }
-        for (int row = 0; row < ks; ++row)
-            for (int col = 0; col < ks; ++col) {
-                const int yy = (row - r + py) % py, xx = (col - r + px) % px;
-                kz[size_t(yy) * px + xx] = {kernel.at(ca, row, col), cb >= 0 ? kernel.at(cb, row, col) : 0.0};
+        }
+    });
+}
+
+// Inverse of forward_real_rows (unnormalised): row t's half spectrum at src(t), its px real values handed to
+// sink(t, src, 2) as values src[0], src[2], ...; two rows per transform, Z_k = A_k + i B_k with
+// A_(px-k) = conj A_k.
+template <class Src, class Sink>
+void inverse_real_rows(int count, int px, int threads, const Src& src, const Sink& sink) {
+    const FftPlan& plan = get_plan(px);
+    const int hx = px / 2 + 1;
+    parallel_for((count + 1) / 2, threads, [&](int begin, int end) {
+        std::vector<cd> z(px), work(px), zero(hx);
+        const double* line = reinterpret_cast<const double*>(z.data());
+        for (int pair = begin; pair < end; ++pair) {
+            const int ta = 2 * pair, tb = ta + 1;
+            const cd* a = src(ta);
+            const cd* b = tb < count ? src(tb) : zero.data();
+            for (int k = 0; k < hx; ++k) z[k] = cd(a[k].real() - b[k].imag(), a[k].imag() + b[k].real());
+            for (int k = hx; k < px; ++k) {
+                const int m = px - k;
+                z[k] = cd(a[m].real() + b[m].imag(), b[m].real() - a[m].imag());
             }
-        detail::fft2d(z, px, py, false, threads);
-        detail::fft2d(kz, px, py, false, threads);
-        std::vector<std::complex<double>> prod(total);
-        parallel_for(py, threads, [&](int begin, int end) {
-            const std::complex<double> half(0.5, 0.0), minus_half_i(0.0, -0.5), i_unit(0.0, 1.0);
-            for (int ky = begin; ky < end; ++ky) {
-                const int my = (py - ky) % py;
-                for (int kx = 0; kx < px; ++kx) {
-                    const int mx = (px - kx) % px;
-                    const size_t idx = size_t(ky) * px + kx, midx = size_t(my) * px + mx;
-                    const std::complex<double> zc = std::conj(z[midx]), kc = std::conj(kz[midx]);
-                    const std::complex<double> a = half * (z[idx] + zc), b = minus_half_i * (z[idx] - zc);
-                    const std::complex<double> ka = half * (kz[idx] + kc), kb = minus_half_i * (kz[idx] - kc);
-                    prod[idx] = a * ka + i_unit * (b * kb);
-                }
-            }
-        });
-        detail::fft2d(prod, px, py, true, threads);
-        for (int y = 0; y < h; ++y)
-            for (int x = 0; x < w; ++x) {
-                const std::complex<double> v = prod[size_t(y) * px + x];
-                float* o = &out.rgb[(size_t(y) * w + x) * 3];
-                o[ca] = static_cast<float>(v.real());
-                if (cb >= 0) o[cb] = static_cast<float>(v.imag());
-            }
+            run_plan<true>(plan, z.data(), work.data(), 1);
+            sink(ta, line);
+            if (tb < count) sink(tb, line + 1);
+        }
+    });
+}
+
+// Per channel, the wrapped kernel K[(dy mod py), (dx mod px)] = sum of the taps k(dy, dx) falling there
+// (taps collide only when 2 r + 1 > px or py; see convolve_fft_impl for why that is harmless), transformed.
+std::shared_ptr<KernelSpectrum> compute_kernel_spectrum(const GlareKernel& kernel, int px, int py, int threads) {
+    auto ks = std::make_shared<KernelSpectrum>();
+    ks->px = px;
+    ks->py = py;
+    ks->radius = kernel.radius;
+    ks->weights = kernel.weights;
+    const int r = kernel.radius, size = kernel.size(), hx = px / 2 + 1;
+    // The distinct padded rows the taps land on.
+    std::vector<int> slot(py, -1), rows;
+    for (int row = 0; row < size; ++row) {
+        const int yy = ((row - r) % py + py) % py;
+        if (slot[yy] < 0) {
+            slot[yy] = static_cast<int>(rows.size());
+            rows.push_back(yy);
+        }
     }
+    const int nrows = static_cast<int>(rows.size());
+    // Wrapped real rows, per channel nrows x px.
+    std::array<std::vector<double>, 3> wrapped;
+    for (int c = 0; c < 3; ++c) {
+        wrapped[c].assign(size_t(nrows) * px, 0.0);
+        for (int row = 0; row < size; ++row) {
+            double* dst = wrapped[c].data() + size_t(slot[((row - r) % py + py) % py]) * px;
+            for (int col = 0; col < size; ++col) dst[((col - r) % px + px) % px] += kernel.at(c, row, col);
+        }
+        ks->spectrum[c].assign(size_t(py) * hx, cd(0.0, 0.0));
+    }
+    forward_real_rows(
+        3 * nrows, px, threads,
+        [&](int t, double* dst) {
+            const double* s = wrapped[t / nrows].data() + size_t(t % nrows) * px;
+            for (int x = 0; x < px; ++x) dst[2 * x] = s[x];
+        },
+        [&](int t) { return ks->spectrum[t / nrows].data() + size_t(rows[t % nrows]) * hx; });
+    const FftPlan& plan = get_plan(py);
+    const int blocks = (hx + kColumnBlock - 1) / kColumnBlock;
+    const double scale = 1.0 / (double(px) * py);
+    parallel_for(3 * blocks, threads, [&](int begin, int end) {
+        std::vector<cd> block(size_t(py) * kColumnBlock), work(block.size());
+        for (int item = begin; item < end; ++item) {
+            cd* s = ks->spectrum[item / blocks].data();
+            const int xb = (item % blocks) * kColumnBlock, bw = std::min(kColumnBlock, hx - xb);
+            for (int y = 0; y < py; ++y) std::copy_n(s + size_t(y) * hx + xb, bw, block.data() + size_t(y) * bw);
+            run_plan<false>(plan, block.data(), work.data(), size_t(bw));
+            for (int y = 0; y < py; ++y)
+                for (int i = 0; i < bw; ++i) s[size_t(y) * hx + xb + i] = scale * block[size_t(y) * bw + i];
+        }
+    });
+    return ks;
+}
+
+// A few recent kernel spectra (kernel content and padded size as the key), most recent first, under a mutex.
+// The newest is always kept; older ones are dropped beyond 4 entries or 512 MB.
+struct SpectrumCache {
+    std::mutex mutex;
+    std::list<std::shared_ptr<const KernelSpectrum>> entries;
+    long long hits = 0, misses = 0;
+};
+
+SpectrumCache& spectrum_cache() {
+    static SpectrumCache cache;
+    return cache;
+}
+
+std::shared_ptr<const KernelSpectrum> kernel_spectrum(const GlareKernel& kernel, int px, int py, int threads) {
+    SpectrumCache& cache = spectrum_cache();
+    {
+        std::lock_guard<std::mutex> lock(cache.mutex);
+        for (auto it = cache.entries.begin(); it != cache.entries.end(); ++it) {
+            const KernelSpectrum& e = **it;
+            if (e.px == px && e.py == py && e.radius == kernel.radius && e.weights == kernel.weights) {
+                ++cache.hits;
+                cache.entries.splice(cache.entries.begin(), cache.entries, it);
+                return cache.entries.front();
+            }
+        }
+        ++cache.misses;
+    }
+    // Built outside the lock (two threads missing together both build it; both results are equal).
+    std::shared_ptr<const KernelSpectrum> fresh = compute_kernel_spectrum(kernel, px, py, threads);
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    cache.entries.push_front(fresh);
+    size_t bytes = 0;
+    for (const auto& e : cache.entries) bytes += e->bytes();
+    while (cache.entries.size() > 1 && (cache.entries.size() > 4 || bytes > (size_t(512) << 20))) {
+        bytes -= cache.entries.back()->bytes();
+        cache.entries.pop_back();
+    }
+    return fresh;
+}
+
+// Linear convolution by circular convolution on a px x py grid, px >= w + r and py >= h + r (1-D argument,
+// per axis, n the image size, P the padded size): the circular result at y in [0, n) is
+//   sum over x in [0, n) and taps |d| <= r with d = y - x (mod P) of k(d) in(x).
+// A term with d = y - x + j P, j != 0, needs |d| >= P - |y - x| >= P - (n - 1) >= r + 1 > r: no such tap.
+// So only d = y - x contributes, the linear convolution with zero padding. This also holds when taps collide
+// in the wrapped kernel (2 r + 1 > P): they are summed there, and only the one with d = y - x can pair with
+// an in-image x. Output rows y >= h are never formed (only h rows are inverse-transformed).
+// Steps: real rows of the 3 channels -> half spectra (two per complex FFT); per block of columns, forward
+// column FFT, product with the cached kernel spectrum, inverse column FFT (kept in L2); inverse rows.
+template <class T>
+void convolve_fft_impl(const T* in, int w, int h, const GlareKernel& kernel, int threads, T* out) {
+    const std::array<int, 2> grid = detail::glare_fft_grid(w, h, kernel.radius);
+    const int px = grid[0], py = grid[1], hx = px / 2 + 1;
+    const std::shared_ptr<const KernelSpectrum> ks = kernel_spectrum(kernel, px, py, threads);
+    // Half spectra of the image rows, per channel h x hx (the padded rows h .. py - 1 are zero).
+    std::array<std::vector<cd>, 3> spec;
+    for (auto& s : spec) s.resize(size_t(h) * hx);
+    forward_real_rows(
+        3 * h, px, threads,
+        [&](int t, double* dst) {
+            const T* src = in + size_t(t % h) * w * 3 + t / h;
+            for (int x = 0; x < w; ++x) dst[2 * x] = double(src[size_t(x) * 3]);
+        },
+        [&](int t) { return spec[t / h].data() + size_t(t % h) * hx; });
+    const FftPlan& plan = get_plan(py);
+    const int blocks = (hx + kColumnBlock - 1) / kColumnBlock;
+    parallel_for(3 * blocks, threads, [&](int begin, int end) {
+        std::vector<cd> block(size_t(py) * kColumnBlock), work(block.size());
+        for (int item = begin; item < end; ++item) {
+            const int c = item / blocks, xb = (item % blocks) * kColumnBlock, bw = std::min(kColumnBlock, hx - xb);
+            cd* s = spec[c].data();
+            const cd* k = ks->spectrum[c].data();
+            for (int y = 0; y < h; ++y) std::copy_n(s + size_t(y) * hx + xb, bw, block.data() + size_t(y) * bw);
+            std::fill(block.begin() + size_t(h) * bw, block.begin() + size_t(py) * bw, cd(0.0, 0.0));
+            run_plan<false>(plan, block.data(), work.data(), size_t(bw));
+            for (int y = 0; y < py; ++y)
+                for (int i = 0; i < bw; ++i) {
+                    cd& v = block[size_t(y) * bw + i];
+                    v = cmul(v, k[size_t(y) * hx + xb + i]);
+                }
+            run_plan<true>(plan, block.data(), work.data(), size_t(bw));
+            for (int y = 0; y < h; ++y) std::copy_n(block.data() + size_t(y) * bw, bw, s + size_t(y) * hx + xb);
+        }
+    });
+    inverse_real_rows(
+        3 * h, px, threads, [&](int t) -> const cd* { return spec[t / h].data() + size_t(t % h) * hx; },
+        [&](int t, const double* src) {
+            T* dst = out + size_t(t % h) * w * 3 + t / h;
+            for (int x = 0; x < w; ++x) dst[size_t(x) * 3] = static_cast<T>(src[2 * x]);
+        });
+}
+
+void check_convolution_input(int w, int h, size_t values, const GlareKernel& kernel) {
+    if (w < 1 || h < 1 || values != size_t(w) * h * 3)
+        throw std::invalid_argument("glare: image size does not match its data");
+    const size_t taps = size_t(kernel.size()) * kernel.size();
+    if (kernel.radius < 0 || kernel.weights[0].size() != taps || kernel.weights[1].size() != taps ||
+        kernel.weights[2].size() != taps)
+        throw std::invalid_argument("glare: kernel weights do not match its radius");
+}
+
+}  // namespace
+
+namespace detail {
+
+std::array<int, 2> glare_fft_grid(int width, int height, int radius) {
+    return {next_fft_size(width + radius), next_fft_size(height + radius)};
+}
+
+std::vector<double> convolve_glare_fft_rgb(const std::vector<double>& rgb, int width, int height,
+                                           const GlareKernel& kernel, int threads) {
+    check_convolution_input(width, height, rgb.size(), kernel);
+    std::vector<double> out(rgb.size());
+    convolve_fft_impl(rgb.data(), width, height, kernel, resolve_threads(threads), out.data());
+    return out;
+}
+
+GlareSpectrumCacheStats glare_spectrum_cache_stats() {
+    SpectrumCache& cache = spectrum_cache();
+    std::lock_guard<std::mutex> lock(cache.mutex);
+    return {cache.hits, cache.misses, static_cast<int>(cache.entries.size())};
+}
+
+}  // namespace detail
+
+Image convolve_glare_fft(const Image& image, const GlareKernel& kernel, int threads) {
+    check_convolution_input(image.width, image.height, image.rgb.size(), kernel);
+    Image out{image.width, image.height, std::vector<float>(image.rgb.size())};
+    convolve_fft_impl(image.rgb.data(), image.width, image.height, kernel, resolve_threads(threads), out.rgb.data());
     return out;
 }
 

@@ -162,19 +162,39 @@ PYBIND11_MODULE(_core, m) {
     m.def(
         "display",
         [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, std::optional<float> exposure,
-           const std::string& tonemap, std::optional<float> white) {
-            const airlight::DisplaySettings settings = display_settings(exposure, tonemap, white);
+           const std::string& tonemap, std::optional<float> white, bool glare, std::optional<double> pupil_diameter,
+           bool eyelashes, double fov_y, airlight::Renderer* renderer) {
+            airlight::DisplaySettings settings = display_settings(exposure, tonemap, white);
+            settings.glare.enabled = glare;
+            settings.glare.pupil_diameter_mm = pupil_diameter;
+            settings.glare.eyelashes = eyelashes;
             const airlight::Image image = image_from_numpy(radiance);
-            std::vector<std::uint8_t> bytes;
-            {
+            airlight::DisplayImage shown;
+            try {
                 py::gil_scoped_release release;
-                bytes = airlight::apply_display(image, settings);
+                shown = renderer != nullptr ? renderer->display(image, settings, fov_y)
+                                            : airlight::display_image(image, settings, fov_y);
+            } catch (const std::invalid_argument& e) {
+                throw py::value_error(e.what());
             }
             py::array_t<std::uint8_t> out({image.height, image.width, 3});
-            if (!bytes.empty()) std::memcpy(out.mutable_data(), bytes.data(), bytes.size());
-            return out;
+            if (!shown.srgb8.empty()) std::memcpy(out.mutable_data(), shown.srgb8.data(), shown.srgb8.size());
+            const airlight::DisplayReport& r = shown.report;
+            py::dict report;
+            report["exposure"] = r.exposure;
+            report["white"] = r.white;
+            report["glare"] = r.glare;
+            report["pupil_diameter"] = r.pupil_diameter_mm;
+            report["glare_kernel_radius"] = r.glare_kernel_radius;
+            report["glare_threshold"] = r.glare_threshold;
+            report["glare_error_bound"] = r.glare_error_bound;
+            report["glare_sources"] = r.glare_sources;
+            report["glare_ms"] = r.glare_ms;
+            report["tone_ms"] = r.tone_ms;
+            return py::make_tuple(out, report);
         },
-        py::arg("radiance"), py::arg("exposure"), py::arg("tonemap"), py::arg("white"));
+        py::arg("radiance"), py::arg("exposure"), py::arg("tonemap"), py::arg("white"), py::arg("glare"),
+        py::arg("pupil_diameter"), py::arg("eyelashes"), py::arg("fov_y"), py::arg("renderer").none(true));
     m.def(
         "auto_exposure",
         [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
@@ -211,7 +231,7 @@ PYBIND11_MODULE(_core, m) {
                 py::gil_scoped_release release;
                 const double pixel_angle = airlight::camera_pixel_angle(fov_y, std::max(image.height, 1));
                 const airlight::GlareKernel kernel = airlight::glare_kernel_rgb(options, pixel_angle);
-                out = airlight::convolve_glare_fft(image, kernel);
+                out = airlight::glare_exact(image, kernel);
             } catch (const std::invalid_argument& e) {
                 throw py::value_error(e.what());
             }

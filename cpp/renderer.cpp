@@ -1,6 +1,7 @@
 #include "airlight/renderer.hpp"
 
 #include "backends.hpp"
+#include "display_stage.hpp"
 
 namespace airlight {
 
@@ -22,6 +23,10 @@ Renderer::~Renderer() = default;
 Backend Renderer::backend() const { return impl_->backend; }
 
 void Renderer::set_cpu_threads(int threads) { impl_->cpu.threads = threads; }
+
+DisplayImage Renderer::display(const Image& linear, const DisplaySettings& settings, double fov_y_degrees) {
+    return run_display_stage(linear, settings, fov_y_degrees, impl_->cpu.threads, impl_->gl.get());
+}
 
 Image Renderer::render(const Scene& scene) {
     const FrameData data = make_frame_data(scene);

@@ -43,6 +43,10 @@ const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic},
 const NameTable<LightType> light_types{{"point", LightType::point}, {"spot", LightType::spot}};
 const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic},
                                                  {"march", AirlightMethod::march}};
+const NameTable<ToneCurve> tone_curves{{"linear", ToneCurve::linear},
+                                       {"loglog", ToneCurve::loglog},
+                                       {"reinhard", ToneCurve::reinhard},
+                                       {"filmic", ToneCurve::filmic}};
 const NameTable<SurfaceType> surface_types{
     {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
 
@@ -468,12 +472,85 @@ Quality parse_quality(const Obj& o) {
     return q;
 }
 
+// The pupil of display.glare: a diameter in [1, 9] mm or "auto" (from the
+// adaptation luminance; include/airlight/glare.hpp).
+std::optional<double> read_pupil(const Value& v) {
+    if (v.j.is_string()) {
+        if (v.j.get<std::string>() == "auto") return std::nullopt;
+        fail(Kind::value, v.field, "expected a diameter in mm or \"auto\", got '" + v.j.get<std::string>() + "'");
+    }
+    if (!v.j.is_number()) fail(Kind::type, v.field, "expected a diameter in mm or \"auto\", got " + type_name(v.j));
+    const double d = read_number(v);
+    if (!(d >= 1.0 && d <= 9.0)) fail(Kind::value, v.field, "must be in [1, 9] mm (got " + format_number(d) + ")");
+    return d;
+}
+
+bool read_bool(const Value& v) {
+    if (!v.j.is_boolean()) fail(Kind::type, v.field, "expected true or false, got " + type_name(v.j));
+    return v.j.get<bool>();
+}
+
+// The "display" object (README "Display"): exposure, tone curve, white point
+// and the eye's glare (null or absent: no glare).
+DisplaySettings parse_display(const Obj& o) {
+    o.check_keys({"exposure", "tonemap", "white", "glare"});
+    DisplaySettings d;
+    if (auto v = o.opt("exposure")) {
+        if (v->j.is_string()) {
+            if (v->j.get<std::string>() != "auto")
+                fail(Kind::value, v->field,
+                     "expected a number >= 0 or \"auto\", got '" + v->j.get<std::string>() + "'");
+            d.exposure_mode = ExposureMode::automatic;
+        } else {
+            if (!v->j.is_number())
+                fail(Kind::type, v->field, "expected a number >= 0 or \"auto\", got " + type_name(v->j));
+            const double e = read_number(*v);
+            if (e < 0) fail(Kind::value, v->field, "must be >= 0");
+            if (!std::isfinite(static_cast<float>(e))) fail(Kind::value, v->field, "out of range for a 32-bit float");
+            d.exposure_mode = ExposureMode::manual;
+            d.exposure = static_cast<float>(e);
+        }
+    }
+    if (auto v = o.opt("tonemap")) d.curve = read_enum(*v, "tone curve", tone_curves);
+    if (auto v = o.opt("white")) d.white = read_positive(*v, 1e30, true);
+    if (auto v = o.opt("glare"); v && !v->j.is_null()) {
+        Obj g(*v);
+        g.check_keys({"pupil_diameter", "eyelashes"});
+        d.glare.enabled = true;
+        if (auto p = g.opt("pupil_diameter")) d.glare.pupil_diameter_mm = read_pupil(*p);
+        if (auto e = g.opt("eyelashes")) d.glare.eyelashes = read_bool(*e);
+    }
+    return d;
+}
+
+json display_to_json(const DisplaySettings& d) {
+    json j;
+    if (d.exposure_mode == ExposureMode::automatic)
+        j["exposure"] = "auto";
+    else
+        j["exposure"] = json_number(d.exposure);
+    j["tonemap"] = name_of(tone_curves, d.curve);
+    if (d.white) j["white"] = json_number(*d.white);
+    if (d.glare.enabled) {
+        json g;
+        if (d.glare.pupil_diameter_mm)
+            g["pupil_diameter"] = *d.glare.pupil_diameter_mm;
+        else
+            g["pupil_diameter"] = "auto";
+        g["eyelashes"] = d.glare.eyelashes;
+        j["glare"] = g;
+    } else {
+        j["glare"] = nullptr;
+    }
+    return j;
+}
+
 }  // namespace
 
 Scene parse_scene_json(const json& j) {
     if (!j.is_object()) fail(Kind::type, "", "scene must be a JSON object");
     Obj top(Value{j, ""});
-    top.check_keys({"film", "camera", "medium", "lights", "surfaces", "background", "quality"});
+    top.check_keys({"film", "camera", "medium", "lights", "surfaces", "background", "quality", "display"});
     Scene s;
     s.film = parse_film(Obj(top.req("film")));
     s.camera = parse_camera(Obj(top.req("camera")));
@@ -485,6 +562,7 @@ Scene parse_scene_json(const json& j) {
     s.surfaces = read_list<Surface>(top.opt("surfaces"), parse_surface);
     if (auto v = top.opt("background")) s.background = read_rgb(*v);
     if (auto v = top.opt("quality")) s.quality = parse_quality(Obj(*v));
+    if (auto v = top.opt("display")) s.display = parse_display(Obj(*v));
     return s;
 }
 
@@ -553,6 +631,7 @@ json scene_to_json_value(const Scene& s) {
                     {"march_steps", s.quality.march_steps},
                     {"cull_fraction", json_number(s.quality.cull_fraction)},
                     {"spot_glow_samples", s.quality.spot_glow_samples}};
+    j["display"] = display_to_json(s.display);
     return j;
 }
 

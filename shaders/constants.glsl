@@ -3,6 +3,10 @@
 
 CONST float PI = 3.14159265358979f;
 CONST float NO_HIT = 3.0e38f;  // "infinitely far" distance along a ray
+// Lamp cores whose projected radius is below this many pixels are
+// box-filtered onto the film instead of being hit by pixel rays
+// (lamp_subpixel_cores in shading.glsl).
+CONST float LAMP_SUBPIXEL_RADIUS = 1.0f;
 
 // ---- Tables -------------------------------------------------------------
 // Normalised airlight tail S(X, Y) (docs/airlight_table.md):

@@ -138,7 +138,109 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
                 scale.z > 0.0f ? medium_airlight_segment(sigma_t.z, b, h, x0, x_end, log(scale.z)) : 0.0f);
 }
 
-// Radiance arriving at the camera along the ray origin + t dir.
+// ---- Lamp cores smaller than a pixel ---------------------------------------
+// A lamp's disc that projects smaller than LAMP_SUBPIXEL_RADIUS pixels is
+// missed or hit at random by one ray through the pixel's centre (a distant
+// headlight would flicker or vanish). Such cores are box-filtered instead:
+// the disc becomes the square of the same area on the image plane, and each
+// pixel gets the lamp's radiance times the fraction of its area that square
+// covers. The square's area is the disc's projected area, pi r^2 / (d^2
+// cos^3 theta) at distance d and off-axis angle theta (a solid angle Omega
+// projects to Omega / cos^3 theta on the plane at distance 1), so the energy
+// over all pixels is exactly the lamp's, L pi r^2 / d^2 (issue 8: the
+// glare's point sources must carry their true energy).
+
+// Position of `rel` (a point relative to the camera) on the film in
+// continuous pixel units (x right, row down; pixel (x, row) spans
+// [x, x + 1] x [row, row + 1]) in .xy, the projected square's half side in
+// pixels in .z; .z = NO_HIT for points not in front of the camera.
+vec3 lamp_film_square(vec3 rel, float r) {
+    vec3 forward = vec3(frame.camera_forward);
+    vec3 right = vec3(frame.camera_right);
+    vec3 up = vec3(frame.camera_up);
+    float z = dot(rel, forward);
+    float d = length(rel);
+    if (z <= r || d <= r) return vec3(0.0f, 0.0f, NO_HIT);
+    float sx = dot(rel, right) / (z * dot(right, right));
+    float sy = dot(rel, up) / (z * dot(up, up));
+    float width = float(frame.film_counts.x);
+    float height = float(frame.film_counts.y);
+    float pixel = 2.0f * length(up) / height;  // pixel side on the plane at distance 1
+    float cos_theta = z / d;
+    float disc_radius = r / (d * cos_theta * sqrt(cos_theta));  // equal projected area
+    float half_side = 0.5f * sqrt(PI) * disc_radius / pixel;
+    return vec3(0.5f * (sx + 1.0f) * width, 0.5f * (1.0f - sy) * height, half_side);
+}
+
+// True when the lamp (centre relative to the camera, radius r) is drawn by
+// lamp_subpixel_cores, not by the pixel's ray.
+bool lamp_is_subpixel(vec3 rel, float r) {
+    float half_side = lamp_film_square(rel, r).z;
+    return half_side < 0.5f * sqrt(PI) * LAMP_SUBPIXEL_RADIUS;
+}
+
+// Fraction of pixel (x, row) covered by the lamp's film square (0 when the
+// lamp is resolved: the ray draws it).
+float lamp_pixel_coverage(vec3 rel, float r, int x, int row) {
+    vec3 sq = lamp_film_square(rel, r);
+    if (!(sq.z < 0.5f * sqrt(PI) * LAMP_SUBPIXEL_RADIUS)) return 0.0f;
+    float ox = min(float(x + 1), sq.x + sq.z) - max(float(x), sq.x - sq.z);
+    float oy = min(float(row + 1), sq.y + sq.z) - max(float(row), sq.y - sq.z);
+    return max(ox, 0.0f) * max(oy, 0.0f);
+}
+
+// Weight of a sub-pixel core in pixel (x, row): its coverage times the
+// ratio of the solid angle of a pixel at the lamp's centre to this pixel's,
+// (cos theta_lamp / cos theta_pixel)^3, so that the energy the pixels get,
+// sum of radiance x pixel solid angle, is the lamp's whatever the pixel.
+float lamp_pixel_weight(vec3 rel, float r, int x, int row) {
+    float cover = lamp_pixel_coverage(rel, r, x, row);
+    if (cover <= 0.0f) return 0.0f;
+    vec3 forward = vec3(frame.camera_forward);
+    float ratio = (dot(rel, forward) / length(rel)) / dot(camera_ray_direction(x, row), forward);
+    return cover * ratio * ratio * ratio;
+}
+
+// Radiance of pixel (x, row) with its sub-pixel lamp cores composited over
+// `radiance` (the pixel's ray without them): each covers its share of the
+// pixel (lamp_pixel_weight) with its attenuated core radiance, unless a
+// surface hides its centre.
+vec3 lamp_subpixel_cores(int x, int row, vec3 radiance) {
+    vec3 origin = vec3(frame.camera_position);
+    if (HAS_POINT_LIGHTS) {
+        for (int i = 0; i < point_light_count(); ++i) {
+            PointLightGpu lamp = point_light(i);
+            float r = lamp.position_radius.w;
+            vec3 rel = vec3(lamp.position_radius) - origin;
+            float cover = lamp_pixel_weight(rel, r, x, row);
+            if (cover <= 0.0f) continue;
+            float d = length(rel);
+            int hit = -1;
+            vec3 n;
+            if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
+            radiance = mix(radiance, vec3(lamp.intensity) / (PI * r * r) * transmittance(d), cover);
+        }
+    }
+    if (HAS_SPOT_LIGHTS) {
+        for (int i = 0; i < spot_light_count(); ++i) {
+            SpotLightGpu s = spot_light(i);
+            float r = s.relative_position_radius.w;
+            vec3 rel = vec3(s.relative_position_radius);
+            float cover = lamp_pixel_weight(rel, r, x, row);
+            if (cover <= 0.0f) continue;
+            float d = length(rel);
+            int hit = -1;
+            vec3 n;
+            if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
+            vec3 core = vec3(s.intensity_edge) * (spot_profile_toward(s, -rel / d) / (PI * r * r));
+            radiance = mix(radiance, core * transmittance(d), cover);
+        }
+    }
+    return radiance;
+}
+
+// Radiance arriving at the camera along the ray origin + t dir (lamp cores
+// smaller than a pixel excepted: lamp_subpixel_cores).
 vec3 ray_radiance(vec3 origin, vec3 dir) {
     int hit_index = -1;
     vec3 normal = vec3(0.0f, 1.0f, 0.0f);
@@ -151,7 +253,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     int spot_index = -1;
     if (HAS_POINT_LIGHTS) {
         for (int i = 0; i < point_light_count(); ++i) {
-            float t = intersect_lamp(point_light(i), origin, dir);
+            PointLightGpu lamp = point_light(i);
+            if (lamp_is_subpixel(vec3(lamp.position_radius) - origin, lamp.position_radius.w)) continue;
+            float t = intersect_lamp(lamp, origin, dir);
             if (t < t_hit) {
                 t_hit = t;
                 lamp_index = i;
@@ -162,6 +266,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     if (HAS_SPOT_LIGHTS) {
         for (int i = 0; i < spot_light_count(); ++i) {
             SpotLightGpu s = spot_light(i);
+            if (lamp_is_subpixel(vec3(s.relative_position_radius), s.relative_position_radius.w)) continue;
             PointLightGpu sphere;
             sphere.position_radius = vec4(vec3(s.world_position), s.relative_position_radius.w);
             sphere.intensity = s.intensity_edge;
@@ -211,5 +316,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
 
 // Linear radiance of pixel (x, row), row 0 on top: the per-pixel entry point.
 vec3 render_pixel(int x, int row) {
-    return ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
+    vec3 radiance = ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
+    if (HAS_POINT_LIGHTS || HAS_SPOT_LIGHTS) radiance = lamp_subpixel_cores(x, row, radiance);
+    return radiance;
 }

@@ -5,39 +5,21 @@
 // implementation, multithreaded over rows.
 #pragma once
 
+#include <array>
 #include <cstdint>
+#include <memory>
 #include <optional>
 #include <string>
 #include <vector>
 
+#include "airlight/display_settings.hpp"
+#include "airlight/glare.hpp"
 #include "airlight/renderer.hpp"
 
 namespace airlight {
 
-enum class ExposureMode {
-    manual,     // DisplaySettings::exposure multiplies the radiance
-    automatic,  // exposure = key / log-average luminance (auto_exposure)
-};
-
-// The tone curves of shaders/display.glsl (their ids there: TONE_*).
-enum class ToneCurve {
-    linear,    // L / W, clipped
-    loglog,    // the source paper's double logarithm: ln(1 + ln(1 + L)) / ln(1 + ln(1 + W))
-    reinhard,  // extended Reinhard (2002) with white point W
-    filmic,    // ACES fit of Narkowicz (2015), white point W
-};
-
 // Reinhard et al. 2002's key: the exposed log-average luminance of a scene.
 constexpr float kAutoExposureKey = 0.18f;
-
-struct DisplaySettings {
-    ExposureMode exposure_mode = ExposureMode::automatic;
-    float exposure = 1.0f;  // used when exposure_mode is manual; finite, >= 0
-    ToneCurve curve = ToneCurve::loglog;
-    // The exposed luminance that maps to display value 1; empty: the curve's
-    // default (default_white). Finite and > 0.
-    std::optional<float> white;
-};
 
 // "linear", "loglog", "reinhard", "filmic".
 const char* tone_curve_name(ToneCurve curve);
@@ -68,9 +50,113 @@ float resolve_exposure(const Image& image, const DisplaySettings& settings, int 
 // [0, 1], before sRGB encoding.
 float tone_map_luminance(ToneCurve curve, float luminance, float white);
 
-// The whole display stage: width * height RGB bytes, row 0 on top,
-// round(255 * display_pixel(...)). Validates `settings` first. threads <= 0:
-// one per hardware thread.
+// The tone stage alone (exposure, curve, sRGB; settings.glare is ignored):
+// width * height RGB bytes, row 0 on top, round(255 * display_pixel(...)).
+// Validates `settings` first. threads <= 0: one per hardware thread.
 std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettings& settings, int threads = 0);
+
+// Luminous efficacy used to read the renderer's luminance Y (Rec. 709
+// weights of the linear channels, W / (m^2 sr)) as cd/m^2 for the pupil's
+// adaptation: 683 lm/W, the photopic maximum (an equal-weight assumption:
+// the channels are taken as already photometrically weighted).
+constexpr double kLuminousEfficacy = 683.0;
+
+// The steepest response of a grey pixel's display value (in [0, 1], before
+// 8-bit rounding) to its exposed value, from `exposed` up: max over
+// y >= exposed of d/dy srgb_oetf(f(y)), f the tone curve (non-increasing in
+// `exposed`, so it bounds the slope over any interval starting there).
+// Tabulated on a log grid over [1e-8, 1e3] x white (display_stage.cpp).
+class DisplaySlope {
+public:
+    DisplaySlope(ToneCurve curve, float white);
+    double at_least(double exposed) const;
+
+private:
+    double log_lo_ = 0.0, step_ = 0.0;
+    std::vector<double> envelope_;
+};
+
+// How the glare of one display run is done (plan_glare; docs/glare.md
+// "Skipping what does not show").
+//
+// The exact glare is K * v (K the kernel, centre weight k_c). Split v into a
+// clipped part B = min(v, T) and the excess E = v - B, with a threshold T per
+// tile of the image (tiles of the kernel's radius), and show B + K * E. The
+// error at pixel p is (K * B - B)(p) = sum_d K(d) (B_{p+d} - B_p). The
+// kernel's window around p lies inside the 3 x 3 tiles around p's tile; over
+// them let R be the range of B (max - min, worst channel) and s the largest
+// step between neighbouring pixels. Then |B_{p+d} - B_p| <= min(s |d|_1, R),
+// and e_t = sum_d K(d) min(s |d|_1, R) (max over channels; with any value
+// clipped, s is not known and e_t = (1 - k_c) R) bounds the error on all of
+// the tile's pixels: smooth fog gets a small bound from s, a lamp's core a
+// large one from R. The thresholds are the largest with
+// e_t * exposure * DisplaySlope(exposure * (min B in the tile - e_t)) <= 1/2
+// of an 8-bit step on every tile: the dropped glare moves no grey pixel's
+// 8-bit value by more than one step. A tile whose neighbourhood passes
+// unclipped keeps no threshold (nothing spread there); a lamp's core gets a
+// threshold just above the fog around it and its excess is spread exactly;
+// with nothing above any threshold the glare is skipped.
+struct GlarePlan {
+    bool enabled = false;                       // settings.glare.enabled and exposure > 0
+    double pupil_diameter_mm = 0.0;             // given or from the adaptation luminance
+    double pixel_angle = 0.0;                   // camera_pixel_angle(fov_y, height)
+    std::shared_ptr<const GlareKernel> kernel;  // cached per (pupil, eyelashes, pixel angle)
+    int tile = 1, tiles_x = 0;                  // tile side (pixels), tiles per row
+    std::vector<float> tile_threshold;          // T per tile, radiance (every channel)
+    double error_bound = 0.0;                   // max over tiles of e_t, radiance
+    long long sources = 0;                      // pixels with a channel above their tile's T; 0: glare skipped
+    float threshold_at(int x, int y) const {
+        return tile_threshold[size_t(y / tile) * size_t(tiles_x) + size_t(x / tile)];
+    }
+};
+
+// The eye's glare as shown by the display stage: the image extended by
+// copies of its edge pixels (extend_edges: the world goes on past the frame,
+// so the border gathers glare from outside as it loses glare to it; a uniform
+// image is unchanged), convolved with the kernel (convolve_glare_fft),
+// cropped. NaN and negative radiance count as 0.
+Image glare_exact(const Image& linear, const GlareKernel& kernel, int threads = 0);
+// `image` with `margin` copies of its edge rows and columns on every side.
+Image extend_edges(const Image& image, int margin);
+// The width x height window of `image` whose top-left pixel is (x0, y0).
+Image crop(const Image& image, int x0, int y0, int width, int height);
+
+// The glare plan for `linear` shown with `exposure` and the curve. Throws
+// std::invalid_argument naming display.glare.pupil_diameter for a pupil
+// outside [1, 9] mm, or camera.fov_y for a field of view outside (0, 180).
+GlarePlan plan_glare(const Image& linear, const DisplaySettings& settings, float exposure, double fov_y_degrees,
+                     int threads = 0);
+
+// The glare of `plan` on the CPU: nothing when plan.sources == 0; else
+// B + K * E (see GlarePlan) by splatting the sources' excess when they are
+// few, or the exact convolution K * v (glare_exact) when splatting would
+// cost more; both over the edge-extended image. `method` (if given) says which: "off", "skipped",
+// "sparse" or "fft".
+Image apply_glare_plan(const Image& linear, const GlarePlan& plan, int threads = 0, std::string* method = nullptr);
+
+// What a display run did.
+struct DisplayReport {
+    float exposure = 1.0f;
+    float white = 1.0f;
+    std::string glare = "off";  // "off", "skipped", "sparse", "fft" (CPU) or "gl-fft"
+    double pupil_diameter_mm = 0.0;
+    int glare_kernel_radius = 0;
+    double glare_threshold = 0.0;    // radiance; see GlarePlan
+    double glare_error_bound = 0.0;  // radiance; see GlarePlan
+    long long glare_sources = 0;
+    double glare_ms = 0.0;  // kernel (first use of a pupil / pixel angle) and convolution
+    double tone_ms = 0.0;
+};
+
+struct DisplayImage {
+    int width = 0, height = 0;
+    std::vector<std::uint8_t> srgb8;  // width * height RGB bytes, row 0 on top
+    DisplayReport report;
+};
+
+// The whole display stage on the CPU: exposure (from the linear image before
+// glare), glare (settings.glare; its angular scale from fov_y and the image's
+// height), tone curve, sRGB. Renderer::display runs the same on either backend.
+DisplayImage display_image(const Image& linear, const DisplaySettings& settings, double fov_y_degrees, int threads = 0);
 
 }  // namespace airlight

@@ -106,7 +106,9 @@ GlareKernel glare_kernel_rgb(const GlareOptions& options, double pixel_angle);
 
 // Convolution of linear RGB radiance by the kernel, per channel, with zero
 // padding (light falling beyond the border is lost, none wraps around).
-// threads <= 0: hardware concurrency.
+// threads <= 0: hardware concurrency. The FFT version works in double
+// precision on a (w + r) x (h + r) grid rounded up to 2^a 3^b 5^c, and keeps
+// the last few kernel spectra (keyed by kernel and grid) for the next call.
 Image convolve_glare_fft(const Image& image, const GlareKernel& kernel, int threads = 0);
 Image convolve_glare_direct(const Image& image, const GlareKernel& kernel, int threads = 0);
 
@@ -122,12 +124,28 @@ bool glare_needed(const Image& image, const GlareKernel& kernel, double display_
 
 // Internal pieces, exposed for the tests.
 namespace detail {
-// In-place iterative radix-2 FFT; size must be a power of two. Forward:
+// In-place mixed-radix FFT (Stockham autosort, radices 4, 2, 3, 5); the size
+// must be a product of 2, 3 and 5 (std::invalid_argument otherwise). Forward:
 // X_k = sum_n x_n exp(-2 pi i k n / N); inverse includes the 1/N.
 void fft(std::vector<std::complex<double>>& data, bool inverse);
-// 2-D FFT of a row-major ny x nx array (both powers of two), rows then columns.
+// 2-D FFT of a row-major ny x nx array (both products of 2, 3 and 5), rows then columns.
 void fft2d(std::vector<std::complex<double>>& data, int nx, int ny, bool inverse, int threads = 1);
 int next_pow2(int n);
+// n > 0 with no prime factor other than 2, 3 and 5.
+bool is_fft_size(int n);
+// Smallest 2^a 3^b 5^c >= n.
+int next_fft_size(int n);
+// The padded grid {px, py} of convolve_glare_fft: next_fft_size(width + radius), next_fft_size(height + radius).
+std::array<int, 2> glare_fft_grid(int width, int height, int radius);
+// convolve_glare_fft on interleaved RGB doubles (width * height * 3), output in double.
+std::vector<double> convolve_glare_fft_rgb(const std::vector<double>& rgb, int width, int height,
+                                           const GlareKernel& kernel, int threads = 0);
+// Kernel spectrum cache counters since the start of the process.
+struct GlareSpectrumCacheStats {
+    long long hits = 0, misses = 0;
+    int entries = 0;
+};
+GlareSpectrumCacheStats glare_spectrum_cache_stats();
 }  // namespace detail
 
 }  // namespace airlight

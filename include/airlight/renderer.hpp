@@ -12,6 +12,9 @@ namespace airlight {
 
 enum class Backend { cpu, gl };
 
+struct DisplaySettings;  // airlight/display_settings.hpp
+struct DisplayImage;     // airlight/display.hpp
+
 const char* backend_name(Backend backend);
 
 // Thrown when the GL backend cannot run here (no EGL, no OpenGL 4.5 context,
@@ -47,6 +50,12 @@ public:
 
     Backend backend() const;
     Image render(const Scene& scene);
+
+    // The display stage (include/airlight/display.hpp, display_image) on this
+    // renderer's backend: the GL backend runs the glare convolution and the
+    // tone curve on the GPU. fov_y_degrees: the camera's vertical field of
+    // view (the glare's angular scale). Include airlight/display.hpp to call.
+    DisplayImage display(const Image& linear, const DisplaySettings& settings, double fov_y_degrees);
 
     // Number of CPU threads used by the CPU backend (default: all cores).
     void set_cpu_threads(int threads);

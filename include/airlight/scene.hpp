@@ -6,6 +6,8 @@
 #include <string>
 #include <vector>
 
+#include "airlight/display_settings.hpp"
+
 namespace airlight {
 
 // Linear RGB triple (radiance, intensity, coefficients, albedo), per channel.
@@ -123,6 +125,9 @@ struct Scene {
     std::vector<Surface> surfaces;
     Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium)
     Quality quality;
+    // How the demo and Renderer::display turn the radiance into an image
+    // (issue 8); render() itself always returns linear radiance.
+    DisplaySettings display;
 };
 
 }  // namespace airlight

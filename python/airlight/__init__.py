@@ -38,6 +38,8 @@ __all__ = [
     "auto_exposure",
     "available_backends",
     "display",
+    "display_report",
+    "display_scene",
     "gl_unavailable_reason",
     "glare",
     "headlights",
@@ -212,18 +214,78 @@ def _tonemap_args(tonemap: Any, white: Any) -> tuple[str, float | None]:
     return tonemap, w
 
 
+GlareLike = Union[bool, None, Mapping[str, Any]]
+"""The ``glare`` argument of :func:`display`: ``None``/``False`` (off),
+``True`` (pupil from the adaptation luminance, no eyelashes) or a dict as the
+scene format's ``display.glare``: ``{"pupil_diameter": mm or "auto",
+"eyelashes": bool}``."""
+
+
+def _glare_args(glare: Any) -> tuple[bool, float | None, bool]:
+    """(enabled, pupil diameter or None for "auto", eyelashes); errors name ``glare...``."""
+    if glare is None or glare is False:
+        return False, None, False
+    if glare is True:
+        return True, None, False
+    if not isinstance(glare, Mapping):
+        raise TypeError(f"glare: expected None, a bool or a dict, got {type(glare).__name__}")
+    unknown = sorted(set(glare) - {"pupil_diameter", "eyelashes"})
+    if unknown:
+        raise ValueError(f"glare.{unknown[0]}: unknown key (allowed: pupil_diameter, eyelashes)")
+    pupil: float | None = None
+    value = glare.get("pupil_diameter", "auto")
+    if isinstance(value, str):
+        if value != "auto":
+            raise ValueError(f"glare.pupil_diameter: expected a diameter in mm or 'auto', got {value!r}")
+    else:
+        pupil = _real("glare.pupil_diameter", value)
+        if not 1.0 <= pupil <= 9.0:
+            raise ValueError(f"glare.pupil_diameter: must be in [1, 9] mm, got {value!r}")
+    eyelashes = glare.get("eyelashes", False)
+    if not isinstance(eyelashes, bool):
+        raise TypeError(f"glare.eyelashes: expected a bool, got {type(eyelashes).__name__}")
+    return True, pupil, eyelashes
+
+
+def _display(radiance: Any, exposure: Any, tonemap: Any, white: Any, glare: Any, fov_y: Any,
+             renderer: Renderer | None) -> tuple[np.ndarray, dict[str, Any]]:
+    image = _radiance_array(radiance)
+    tonemap, w = _tonemap_args(tonemap, white)
+    if isinstance(exposure, str):
+        if exposure != "auto":
+            raise ValueError(f"exposure: must be 'auto' or a number >= 0, got {exposure!r}")
+        manual = None
+    else:
+        manual = _real("exposure", exposure)
+        if manual < 0:
+            raise ValueError(f"exposure: must be >= 0, got {exposure!r}")
+    enabled, pupil, eyelashes = _glare_args(glare)
+    fov = 60.0
+    if enabled:
+        if fov_y is None:
+            raise TypeError("fov_y: the camera's vertical field of view (degrees) is needed for glare")
+        fov = _real("fov_y", fov_y)
+        if not 0 < fov < 180:
+            raise ValueError(f"fov_y: must be in (0, 180) degrees, got {fov_y!r}")
+    native = renderer._active() if renderer is not None else None
+    out, report = _core.display(image, manual, tonemap, w, enabled, pupil, eyelashes, fov, native)
+    return out, dict(report)
+
+
 def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: str = "loglog",
-            white: float | None = None) -> np.ndarray:
+            white: float | None = None, glare: GlareLike = None, fov_y: float | None = None,
+            renderer: Renderer | None = None) -> np.ndarray:
     """What the eye sees: 8-bit sRGB (uint8, shape (height, width, 3)) of linear
     radiance (float (height, width, 3), e.g. from :func:`render`), computed by
-    the native display stage (multithreaded; the same per-pixel code as the GL
-    display pass, ``shaders/display.glsl``).
+    the native display stage: on the CPU (multithreaded), or on ``renderer``'s
+    backend when given (the GL backend runs the glare and the tone curve on the
+    GPU; the same per-pixel code, ``shaders/display.glsl``).
 
-    Steps: each channel is multiplied by the exposure (NaN, negative and
-    infinite values count as 0); the tone curve is applied to the Rec. 709
-    luminance ``Y = 0.2126 R + 0.7152 G + 0.0722 B`` and the pixel scaled by
-    ``f(Y) / Y`` (colours keep their chromaticity; channels above 1 clip);
-    then the sRGB OETF (IEC 61966-2-1) and rounding to 8 bits.
+    Steps: optional glare (below); each channel is multiplied by the exposure
+    (NaN, negative and infinite values count as 0); the tone curve is applied
+    to the Rec. 709 luminance ``Y = 0.2126 R + 0.7152 G + 0.0722 B`` and the
+    pixel scaled by ``f(Y) / Y`` (colours keep their chromaticity; channels
+    above 1 clip); then the sRGB OETF (IEC 61966-2-1) and rounding to 8 bits.
 
     - ``exposure``: ``"auto"`` (default) maps the log-average luminance of
       the pixels with finite ``Y > 0`` to the key 0.18 (Reinhard et al. 2002);
@@ -240,21 +302,46 @@ def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: st
       non-decreasing, and is clipped to [0, 1]; see
       ``docs/images/tone_curves.png``.
     - ``white``: ``W``, a number > 0; ``None`` for the curve's default.
+    - ``glare``: the eye's diffraction glare (see :func:`glare` and
+      ``docs/glare.md``), ``None`` (off), ``True`` or
+      ``{"pupil_diameter": mm in [1, 9] or "auto", "eyelashes": bool}``;
+      ``"auto"`` takes the pupil from the image's log-average luminance
+      (Moon & Spencer). Light the glare would visibly move is spread
+      exactly; light whose glare provably moves no 8-bit value by more than
+      one step stays in place, and with nothing to spread the convolution is
+      skipped (``docs/glare.md``). Needs ``fov_y``.
+    - ``fov_y``: the camera's vertical field of view in degrees (the glare's
+      angle per pixel).
 
     Bad arguments raise ``TypeError``/``ValueError`` naming the argument
-    (``"exposure: must be >= 0, got -1"``).
+    (``"exposure: must be >= 0, got -1"``). :func:`display_report` returns
+    what was done as well.
     """
-    image = _radiance_array(radiance)
-    tonemap, w = _tonemap_args(tonemap, white)
-    if isinstance(exposure, str):
-        if exposure != "auto":
-            raise ValueError(f"exposure: must be 'auto' or a number >= 0, got {exposure!r}")
-        manual = None
-    else:
-        manual = _real("exposure", exposure)
-        if manual < 0:
-            raise ValueError(f"exposure: must be >= 0, got {exposure!r}")
-    return _core.display(image, manual, tonemap, w)
+    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer)[0]
+
+
+def display_report(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: str = "loglog",
+                   white: float | None = None, glare: GlareLike = None, fov_y: float | None = None,
+                   renderer: Renderer | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+    """:func:`display` and what it did: ``exposure`` and ``white`` used,
+    ``glare`` (``"off"``, ``"skipped"`` when no pixel is bright enough,
+    ``"sparse"`` or ``"fft"`` on the CPU, ``"gl-fft"`` on GL),
+    ``pupil_diameter`` (mm), ``glare_kernel_radius`` (pixels),
+    ``glare_threshold`` (radiance: the excess of each channel over it is
+    spread, see ``docs/glare.md``), ``glare_error_bound`` (radiance: no pixel
+    differs from the exact convolution by more), ``glare_sources`` (pixels
+    spread), ``glare_ms`` and ``tone_ms``."""
+    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer)
+
+
+def display_scene(radiance: np.ndarray, scene: SceneLike, *, renderer: Renderer | None = None) -> np.ndarray:
+    """:func:`display` with the settings of ``scene``'s ``"display"`` object and
+    its camera's field of view (what ``airlight-demo`` writes to a PNG)."""
+    loaded = load_scene(scene)
+    settings = loaded["display"]
+    return display(radiance, exposure=settings["exposure"], tonemap=settings["tonemap"],
+                   white=settings.get("white"), glare=settings.get("glare"),
+                   fov_y=loaded["camera"]["fov_y"], renderer=renderer)
 
 
 def auto_exposure(radiance: np.ndarray) -> float:
@@ -285,7 +372,11 @@ def glare(radiance: np.ndarray, *, fov_y: float, pupil_diameter: float = 4.0,
     smaller or larger than a pixel. ``fov_y`` (degrees) is the camera's
     vertical field of view, which sets the angle per pixel. The kernel sums to
     1 per channel: glare moves light, it does not create it (docs/glare.md).
-    Work in progress (issue 8): no GL pass and no scene-format key yet.
+    Past the frame the image is taken to continue as its edge pixels (a
+    uniform image is unchanged; the border gathers glare from outside as it
+    loses glare to it). NaN and negative radiance count as 0.
+    This is the exact convolution of every pixel; :func:`display` with
+    ``glare=...`` spreads only the pixels whose glare is visible.
     """
     image = _radiance_array(radiance)
     fov = _real("fov_y", fov_y)

@@ -1,7 +1,8 @@
 // Eye glare (cpp/glare.cpp, docs/glare.md): the FFT against a direct DFT, the
 // Airy pattern's first dark ring, energy conservation, the central pixel's
 // integral when the Airy core is below a pixel, the Rayleigh criterion, FFT
-// against direct convolution, the skip bound and bad pupil diameters.
+// against direct convolution (mixed-radix grids, r = 0, the kernel spectrum
+// cache), convolution timings, the skip bound and bad pupil diameters.
 #include <chrono>
 #include <cmath>
 #include <complex>
@@ -9,6 +10,7 @@
 #include <random>
 #include <stdexcept>
 #include <string>
+#include <thread>
 #include <vector>
 
 #include "airlight/glare.hpp"
@@ -24,55 +26,102 @@ double seconds_since(std::chrono::steady_clock::time_point t0) {
     return std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
 }
 
+// Direct DFT in long double (reference), sign -1 forward; the n roots of unity are computed once.
+std::vector<std::complex<double>> direct_dft(const std::vector<std::complex<double>>& x) {
+    const size_t n = x.size();
+    std::vector<long double> cs(n), sn(n);
+    for (size_t j = 0; j < n; ++j) {
+        const long double a = -2.0L * 3.141592653589793238462643383279503L * (long double)j / n;
+        cs[j] = std::cos(a);
+        sn[j] = std::sin(a);
+    }
+    std::vector<std::complex<double>> out(n);
+    for (size_t k = 0; k < n; ++k) {
+        long double re = 0.0L, im = 0.0L;
+        for (size_t j = 0, e = 0; j < n; ++j, e = (e + k) % n) {
+            re += x[j].real() * cs[e] - x[j].imag() * sn[e];
+            im += x[j].real() * sn[e] + x[j].imag() * cs[e];
+        }
+        out[k] = {double(re), double(im)};
+    }
+    return out;
+}
+
 void test_fft_against_dft() {
     std::mt19937 rng(7);
     std::uniform_real_distribution<double> u(-1.0, 1.0);
-    for (int n : {1, 2, 8, 64, 256}) {
+    // Every 2^a 3^b 5^c up to 256 (powers of two and mixed radix), then larger mixed sizes.
+    std::vector<int> sizes;
+    for (int n = 1; n <= 256; ++n)
+        if (detail::is_fft_size(n)) sizes.push_back(n);
+    for (int n : {360, 375, 648, 1125, 1944}) sizes.push_back(n);
+    double worst = 0.0, worst_round = 0.0;
+    int worst_n = 0;
+    for (int n : sizes) {
         std::vector<std::complex<double>> x(n);
         for (auto& v : x) v = {u(rng), u(rng)};
         std::vector<std::complex<double>> y = x;
         detail::fft(y, false);
+        const std::vector<std::complex<double>> ref = direct_dft(x);
         double err = 0.0, scale = 0.0;
         for (int k = 0; k < n; ++k) {
-            std::complex<double> s = 0.0;
-            for (int j = 0; j < n; ++j) s += x[j] * std::polar(1.0, -2.0 * kPi * double((k * j) % n) / n);
-            err = std::max(err, std::abs(s - y[k]));
-            scale = std::max(scale, std::abs(s));
+            err = std::max(err, std::abs(ref[k] - y[k]));
+            scale = std::max(scale, std::abs(ref[k]));
         }
         std::vector<std::complex<double>> back = y;
         detail::fft(back, true);
         double round = 0.0;
         for (int j = 0; j < n; ++j) round = std::max(round, std::abs(back[j] - x[j]));
-        std::printf("fft n=%d: max |FFT - DFT| / max |DFT| = %.2e, round trip %.2e\n", n, err / scale, round);
-        CHECK_MSG(err <= 1e-12 * scale, "fft n=" + std::to_string(n));
-        CHECK(round < 1e-12);
+        if (err / scale > worst) worst = err / scale, worst_n = n;
+        worst_round = std::max(worst_round, round);
+        CHECK_MSG(err <= 1e-14 * scale, "fft n=" + std::to_string(n));
+        CHECK_MSG(round < 1e-14, "fft round trip n=" + std::to_string(n));
     }
-    // 2-D: 16 columns x 8 rows.
-    const int nx = 16, ny = 8;
-    std::vector<std::complex<double>> a(nx * ny);
-    for (auto& v : a) v = {u(rng), u(rng)};
-    std::vector<std::complex<double>> b = a;
-    detail::fft2d(b, nx, ny, false, 2);
-    double err = 0.0, scale = 0.0;
-    for (int ky = 0; ky < ny; ++ky)
-        for (int kx = 0; kx < nx; ++kx) {
-            std::complex<double> s = 0.0;
-            for (int y = 0; y < ny; ++y)
-                for (int x = 0; x < nx; ++x)
-                    s += a[y * nx + x] * std::polar(1.0, -2.0 * kPi * (double(kx) * x / nx + double(ky) * y / ny));
-            err = std::max(err, std::abs(s - b[ky * nx + kx]));
-            scale = std::max(scale, std::abs(s));
+    std::printf("fft, %zu sizes 1..1944 (2^a 3^b 5^c): max |FFT - DFT| / max |DFT| = %.2e (n=%d), round trip %.2e\n",
+                sizes.size(), worst, worst_n, worst_round);
+    // 2-D: 16 columns x 8 rows, and a mixed-radix 15 x 12.
+    for (const auto& dims : {std::pair<int, int>{16, 8}, std::pair<int, int>{15, 12}}) {
+        const int nx = dims.first, ny = dims.second;
+        std::vector<std::complex<double>> a(nx * ny);
+        for (auto& v : a) v = {u(rng), u(rng)};
+        std::vector<std::complex<double>> b = a;
+        detail::fft2d(b, nx, ny, false, 2);
+        double err = 0.0, scale = 0.0;
+        for (int ky = 0; ky < ny; ++ky)
+            for (int kx = 0; kx < nx; ++kx) {
+                std::complex<double> s = 0.0;
+                for (int y = 0; y < ny; ++y)
+                    for (int x = 0; x < nx; ++x)
+                        s += a[y * nx + x] *
+                             std::polar(1.0, -2.0 * kPi * (double((kx * x) % nx) / nx + double((ky * y) % ny) / ny));
+                err = std::max(err, std::abs(s - b[ky * nx + kx]));
+                scale = std::max(scale, std::abs(s));
+            }
+        detail::fft2d(b, nx, ny, true, 3);
+        double round = 0.0;
+        for (size_t i = 0; i < a.size(); ++i) round = std::max(round, std::abs(b[i] - a[i]));
+        std::printf("fft2d %dx%d: max |FFT - DFT| / max |DFT| = %.2e, round trip %.2e\n", nx, ny, err / scale, round);
+        CHECK(err <= 1e-14 * scale);
+        CHECK(round < 1e-14);
+    }
+    // Sizes with another prime factor are refused.
+    for (int n : {7, 14, 22}) {
+        bool threw = false;
+        try {
+            std::vector<std::complex<double>> bad(n);
+            detail::fft(bad, false);
+        } catch (const std::invalid_argument&) {
+            threw = true;
         }
-    std::printf("fft2d 16x8: max |FFT - DFT| / max |DFT| = %.2e\n", err / scale);
-    CHECK(err <= 1e-12 * scale);
-    bool threw = false;
-    try {
-        std::vector<std::complex<double>> bad(12);
-        detail::fft(bad, false);
-    } catch (const std::invalid_argument&) {
-        threw = true;
+        CHECK_MSG(threw, "fft n=" + std::to_string(n));
     }
-    CHECK(threw);
+    // next_fft_size: the smallest 2^a 3^b 5^c >= n, against a scan.
+    for (int n = 1; n <= 5000; ++n) {
+        int m = n;
+        while (!detail::is_fft_size(m)) ++m;
+        if (detail::next_fft_size(n) != m) CHECK_MSG(false, "next_fft_size " + std::to_string(n));
+    }
+    CHECK(detail::next_fft_size(1942) == 1944 && detail::next_fft_size(1102) == 1125);
 }
 
 // First local minimum of p(k), k = 1, 2, ..., refined as the minimum of the
@@ -311,6 +360,210 @@ void test_fft_vs_direct() {
     }
 }
 
+// A kernel of radius r with random, asymmetric weights (one strong tap off centre), each channel different.
+GlareKernel random_kernel(int r, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.0, 1.0);
+    GlareKernel k;
+    k.radius = r;
+    const int size = k.size();
+    for (int c = 0; c < 3; ++c) {
+        k.weights[c].resize(size_t(size) * size);
+        for (double& v : k.weights[c]) v = 1e-3 * u(rng);
+        k.weights[c][size_t(r) * size + r] = 1.0;
+        if (r > 0) k.weights[c][size_t(r / 2) * size + (c * r) % size] = 0.3;
+    }
+    return k;
+}
+
+// HDR test image: fog in [0.01, 1), lamps up to 1e6 near the borders and inside.
+std::vector<double> hdr_image(int w, int h, unsigned seed) {
+    std::mt19937 rng(seed);
+    std::uniform_real_distribution<double> u(0.01, 1.0);
+    std::vector<double> rgb(size_t(w) * h * 3);
+    for (double& v : rgb) v = u(rng);
+    rgb[0] = 1e6;                                      // top-left corner, red
+    rgb[(size_t(h - 1) * w + (w - 1)) * 3 + 1] = 5e5;  // bottom-right corner, green
+    rgb[(size_t(h / 2) * w + w / 2) * 3 + 2] = 2e5;    // centre, blue
+    return rgb;
+}
+
+// Direct convolution in double (reference for the double FFT path), zero padding.
+std::vector<double> direct_double(const std::vector<double>& rgb, int w, int h, const GlareKernel& k) {
+    const int r = k.radius;
+    std::vector<double> out(rgb.size(), 0.0);
+    for (int y = 0; y < h; ++y)
+        for (int x = 0; x < w; ++x)
+            for (int c = 0; c < 3; ++c) {
+                long double sum = 0.0L;
+                for (int row = 0; row < k.size(); ++row) {
+                    const int sy = y - (row - r);
+                    if (sy < 0 || sy >= h) continue;
+                    for (int col = 0; col < k.size(); ++col) {
+                        const int sx = x - (col - r);
+                        if (sx >= 0 && sx < w)
+                            sum += (long double)k.at(c, row, col) * rgb[(size_t(sy) * w + sx) * 3 + c];
+                    }
+                }
+                out[(size_t(y) * w + x) * 3 + c] = double(sum);
+            }
+    return out;
+}
+
+double max_abs(const std::vector<double>& v) {
+    double m = 0.0;
+    for (double x : v) m = std::max(m, std::abs(x));
+    return m;
+}
+
+double max_diff(const std::vector<double>& a, const std::vector<double>& b) {
+    double m = 0.0;
+    for (size_t i = 0; i < a.size(); ++i) m = std::max(m, std::abs(a[i] - b[i]));
+    return m;
+}
+
+Image to_image(const std::vector<double>& rgb, int w, int h) {
+    Image img{w, h, std::vector<float>(rgb.size())};
+    for (size_t i = 0; i < rgb.size(); ++i) img.rgb[i] = static_cast<float>(rgb[i]);
+    return img;
+}
+
+// FFT convolution (double path within 1e-12 of the image max, float path against convolve_glare_direct) on
+// odd sizes whose padded grid n + r is exactly a mixed-radix size, and a kernel wider than the grid.
+void test_fft_convolution_mixed_sizes() {
+    struct Case {
+        int w, h, r;
+    };
+    double worst = 0.0;
+    for (const Case& cs : {Case{41, 21, 4}, Case{71, 77, 4}, Case{37, 53, 8}, Case{119, 9, 6}, Case{3, 2, 10}}) {
+        const GlareKernel k = random_kernel(cs.r, 100 + cs.w);
+        const std::array<int, 2> grid = detail::glare_fft_grid(cs.w, cs.h, cs.r);
+        const std::vector<double> img = hdr_image(cs.w, cs.h, 7 + cs.h);
+        const std::vector<double> fft = detail::convolve_glare_fft_rgb(img, cs.w, cs.h, k, 2);
+        const std::vector<double> ref = direct_double(img, cs.w, cs.h, k);
+        const double rel = max_diff(fft, ref) / max_abs(img);
+        worst = std::max(worst, rel);
+        // Float path: identical to the direct convolution after rounding to float, up to an ulp.
+        const Image fi = to_image(img, cs.w, cs.h);
+        const Image a = convolve_glare_fft(fi, k, 2), b = convolve_glare_direct(fi, k, 2);
+        double ferr = 0.0, fmax = 0.0;
+        for (size_t i = 0; i < a.rgb.size(); ++i) {
+            ferr = std::max(ferr, double(std::abs(a.rgb[i] - b.rgb[i])) / std::max(1e-30, double(std::abs(b.rgb[i]))));
+            fmax = std::max(fmax, double(std::abs(fi.rgb[i])));
+        }
+        std::printf(
+            "fft convolution %dx%d r=%d (grid %dx%d, 2r+1 %s grid): double |fft - direct| / max %.2e; float path "
+            "max relative diff per pixel %.2e\n",
+            cs.w, cs.h, cs.r, grid[0], grid[1], 2 * cs.r + 1 > std::min(grid[0], grid[1]) ? ">" : "<=", rel, ferr);
+        CHECK_MSG(rel < 1e-12, std::to_string(cs.w) + "x" + std::to_string(cs.h));
+        CHECK(ferr < 2.5e-7);  // at most about one float ulp per pixel, whatever its brightness
+    }
+    // The first two cases land exactly on odd mixed-radix grids.
+    CHECK((detail::glare_fft_grid(41, 21, 4) == std::array<int, 2>{45, 25}));
+    CHECK((detail::glare_fft_grid(71, 77, 4) == std::array<int, 2>{75, 81}));
+    std::printf("fft convolution, mixed-radix grids: worst double error / image max %.2e (limit 1e-12)\n", worst);
+
+    // r = 0: a kernel of one pixel leaves the image as it is.
+    for (const Case& cs : {Case{1, 1, 0}, Case{1, 13, 0}, Case{7, 5, 0}, Case{45, 27, 0}}) {
+        GlareKernel k;
+        k.radius = 0;
+        for (auto& v : k.weights) v = {1.0};
+        const std::vector<double> img = hdr_image(cs.w, cs.h, 3);
+        const std::vector<double> out = detail::convolve_glare_fft_rgb(img, cs.w, cs.h, k, 2);
+        const double rel = max_diff(out, img) / max_abs(img);
+        const Image fi = to_image(img, cs.w, cs.h);
+        const Image fo = convolve_glare_fft(fi, k);
+        double ferr = 0.0;
+        for (size_t i = 0; i < fi.rgb.size(); ++i) ferr = std::max(ferr, double(std::abs(fo.rgb[i] - fi.rgb[i])));
+        std::printf("fft convolution r=0 %dx%d: |out - in| / max %.2e (double), %.2e (float)\n", cs.w, cs.h, rel,
+                    ferr / max_abs(img));
+        CHECK(rel < 1e-12);
+        CHECK(ferr <= 1e-12 * max_abs(img));
+    }
+}
+
+// The kernel spectrum cache: the same kernel on images of other sizes (other grids, and the same grid from a
+// different size) and a kernel differing in one weight give the direct convolution each time.
+void test_kernel_spectrum_cache() {
+    const GlareKernel k = random_kernel(4, 999);
+    GlareKernel k2 = k;
+    k2.weights[1][3] += 1e-9;  // same radius, different content: must not reuse k's spectrum
+    struct Call {
+        const GlareKernel* kernel;
+        int w, h;
+        bool hit;
+    };
+    // 41x29 and 40x31 share the grid 45x36; 52x33 does not.
+    const Call calls[] = {{&k, 41, 29, false}, {&k, 52, 33, false},  {&k, 40, 31, true},
+                          {&k, 41, 29, true},  {&k2, 41, 29, false}, {&k, 52, 33, true}};
+    CHECK((detail::glare_fft_grid(41, 29, 4) == detail::glare_fft_grid(40, 31, 4)));
+    CHECK((detail::glare_fft_grid(41, 29, 4) != detail::glare_fft_grid(52, 33, 4)));
+    for (const Call& call : calls) {
+        const detail::GlareSpectrumCacheStats before = detail::glare_spectrum_cache_stats();
+        const std::vector<double> img = hdr_image(call.w, call.h, 40 + call.w);
+        const std::vector<double> out = detail::convolve_glare_fft_rgb(img, call.w, call.h, *call.kernel, 2);
+        const detail::GlareSpectrumCacheStats after = detail::glare_spectrum_cache_stats();
+        const double rel = max_diff(out, direct_double(img, call.w, call.h, *call.kernel)) / max_abs(img);
+        const bool hit = after.hits == before.hits + 1 && after.misses == before.misses;
+        const bool miss = after.misses == before.misses + 1 && after.hits == before.hits;
+        std::printf("kernel spectrum cache: %s %dx%d -> %s, |fft - direct| / max %.2e (entries %d)\n",
+                    call.kernel == &k ? "k " : "k2", call.w, call.h, hit ? "hit" : (miss ? "miss" : "?"), rel,
+                    after.entries);
+        CHECK(call.hit ? hit : miss);
+        CHECK(rel < 1e-12);
+        CHECK(after.entries >= 1 && after.entries <= 4);
+    }
+}
+
+// Timings (no asserts): the RGB kernel with eyelashes at 60 degrees, first call (kernel spectrum built) and
+// second (cached); at 1080p, 300 random pixels of the double path against a direct sum.
+void test_fft_timing() {
+    for (const auto& dims : {std::pair<int, int>{640, 360}, std::pair<int, int>{1920, 1080}}) {
+        const int w = dims.first, h = dims.second;
+        GlareOptions o;
+        o.eyelashes = true;
+        const GlareKernel k = glare_kernel_rgb(o, camera_pixel_angle(60.0, h));
+        const std::vector<double> img = hdr_image(w, h, 1);
+        const Image fi = to_image(img, w, h);
+        const std::array<int, 2> grid = detail::glare_fft_grid(w, h, k.radius);
+        double t[2];
+        for (double& ti : t) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const Image out = convolve_glare_fft(fi, k);
+            ti = seconds_since(t0);
+            CHECK(out.rgb.size() == fi.rgb.size());
+        }
+        std::printf("fft convolution timing %dx%d, r=%d, grid %dx%d, %u threads: first call %.3f s, second %.3f s\n", w,
+                    h, k.radius, grid[0], grid[1], std::thread::hardware_concurrency(), t[0], t[1]);
+        if (w != 1920) continue;
+        const std::vector<double> out = detail::convolve_glare_fft_rgb(img, w, h, k);
+        std::mt19937 rng(2);
+        double err = 0.0;
+        for (int s = 0; s < 300; ++s) {
+            // Half the samples near the lamps (corners and centre), half anywhere.
+            int x = int(rng() % w), y = int(rng() % h);
+            if (s % 2 == 0) {
+                const int ax[3] = {0, w - 1, w / 2}, ay[3] = {0, h - 1, h / 2};
+                x = std::min(w - 1, std::max(0, ax[s % 3] + int(rng() % 61) - 30));
+                y = std::min(h - 1, std::max(0, ay[s % 3] + int(rng() % 61) - 30));
+            }
+            for (int c = 0; c < 3; ++c) {
+                long double sum = 0.0L;
+                for (int row = 0; row < k.size(); ++row)
+                    for (int col = 0; col < k.size(); ++col) {
+                        const int sy = y - (row - k.radius), sx = x - (col - k.radius);
+                        if (sy >= 0 && sy < h && sx >= 0 && sx < w)
+                            sum += (long double)k.at(c, row, col) * img[(size_t(sy) * w + sx) * 3 + c];
+                    }
+                err = std::max(err, std::abs(double(sum) - out[(size_t(y) * w + x) * 3 + c]));
+            }
+        }
+        std::printf("fft convolution 1920x1080 (double path), 300 sampled pixels vs direct: max error / max %.2e\n",
+                    err / max_abs(img));
+        CHECK(err < 1e-12 * max_abs(img));
+    }
+}
+
 void test_skip_bound() {
     GlareOptions o;
     const GlareKernel k = glare_kernel_rgb(o, camera_pixel_angle(60.0, 360));
@@ -393,6 +646,9 @@ int main() {
     test_energy_and_central_pixel();
     test_rayleigh();
     test_fft_vs_direct();
+    test_fft_convolution_mixed_sizes();
+    test_kernel_spectrum_cache();
+    test_fft_timing();
     test_skip_bound();
     test_bad_input();
     std::printf("test_glare: %.2f s\n", seconds_since(t0));

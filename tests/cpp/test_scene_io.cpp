@@ -94,7 +94,12 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
               same(x.albedo, y.albedo)))
             return false;
     }
-    return true;
+    const airlight::DisplaySettings &da = a.display, &db = b.display;
+    return da.exposure_mode == db.exposure_mode &&
+           (da.exposure_mode == airlight::ExposureMode::automatic || da.exposure == db.exposure) &&
+           da.curve == db.curve && da.white == db.white && da.glare.enabled == db.glare.enabled &&
+           (!da.glare.enabled ||
+            (da.glare.pupil_diameter_mm == db.glare.pupil_diameter_mm && da.glare.eyelashes == db.glare.eyelashes));
 }
 
 struct BadCase {
@@ -522,6 +527,37 @@ const std::vector<BadCase> bad_cases = {
     {"background string", [](json& j) { j["background"] = "black"; }, Kind::type, "background", "got string"},
     {"background NaN", [](json& j) { j["background"] = {0, 0, nan}; }, Kind::value, "background", "must be finite"},
     {"background null", [](json& j) { j["background"] = nullptr; }, Kind::type, "background", "got null"},
+    // Display (issue 8).
+    {"display not an object", [](json& j) { j["display"] = 1; }, Kind::type, "display", "expected an object"},
+    {"display unknown key", [](json& j) { j["display"] = {{"gamma", 2.2}}; }, Kind::value, "display.gamma",
+     "unknown key"},
+    {"exposure negative", [](json& j) { j["display"] = {{"exposure", -1}}; }, Kind::value, "display.exposure",
+     "must be >= 0"},
+    {"exposure word", [](json& j) { j["display"] = {{"exposure", "manual"}}; }, Kind::value, "display.exposure",
+     "\"auto\""},
+    {"exposure bool", [](json& j) { j["display"] = {{"exposure", true}}; }, Kind::type, "display.exposure",
+     "got bool"},
+    {"exposure huge", [](json& j) { j["display"] = {{"exposure", 1e300}}; }, Kind::value, "display.exposure",
+     "32-bit float"},
+    {"tonemap unknown", [](json& j) { j["display"] = {{"tonemap", "aces"}}; }, Kind::value, "display.tonemap",
+     "allowed: linear, loglog, reinhard, filmic"},
+    {"tonemap number", [](json& j) { j["display"] = {{"tonemap", 2}}; }, Kind::type, "display.tonemap",
+     "expected a string"},
+    {"white zero", [](json& j) { j["display"] = {{"white", 0}}; }, Kind::value, "display.white", "must be > 0"},
+    {"glare not an object", [](json& j) { j["display"] = {{"glare", true}}; }, Kind::type, "display.glare",
+     "expected an object"},
+    {"glare unknown key", [](json& j) { j["display"] = {{"glare", {{"pupil", 4}}}}; }, Kind::value,
+     "display.glare.pupil", "unknown key"},
+    {"pupil too small", [](json& j) { j["display"] = {{"glare", {{"pupil_diameter", 0.5}}}}; }, Kind::value,
+     "display.glare.pupil_diameter", "must be in [1, 9] mm"},
+    {"pupil too large", [](json& j) { j["display"] = {{"glare", {{"pupil_diameter", 9.5}}}}; }, Kind::value,
+     "display.glare.pupil_diameter", "must be in [1, 9] mm"},
+    {"pupil word", [](json& j) { j["display"] = {{"glare", {{"pupil_diameter", "dark"}}}}; }, Kind::value,
+     "display.glare.pupil_diameter", "\"auto\""},
+    {"pupil NaN", [](json& j) { j["display"] = {{"glare", {{"pupil_diameter", nan}}}}; }, Kind::value,
+     "display.glare.pupil_diameter", "must be finite"},
+    {"eyelashes number", [](json& j) { j["display"] = {{"glare", {{"eyelashes", 1}}}}; }, Kind::type,
+     "display.glare.eyelashes", "expected true or false"},
 };
 
 void test_bad_cases() {
@@ -778,6 +814,13 @@ void test_round_trip() {
         j["lights"].insert(j["lights"].begin(), spot);  // written after the point light
         j["surfaces"][0]["normal"] = vec();
         j["surfaces"].push_back({{"type", "sphere"}, {"center", vec()}, {"radius", std::pow(10.0, expo(rng))}});
+        const char* curves[] = {"linear", "loglog", "reinhard", "filmic"};
+        j["display"] = {{"exposure", i % 3 == 0 ? json("auto") : json(std::pow(10.0, expo(rng)))},
+                        {"tonemap", curves[i % 4]}};
+        if (i % 5 == 0) j["display"]["white"] = std::pow(10.0, expo(rng));
+        if (i % 2 == 0)
+            j["display"]["glare"] = {{"pupil_diameter", i % 6 == 0 ? json("auto") : json(1.0 + 8.0 * unit(rng))},
+                                     {"eyelashes", i % 4 == 0}};
         airlight::Scene a;
         try {
             a = airlight::parse_scene_json(j);

@@ -524,16 +524,40 @@ def cull_reference_radiance(sc: Scene) -> float:
 
 # ---- pixel selection ---------------------------------------------------------------------------
 
+def subpixel_core_pixels(sc: Scene, centres: Sequence[np.ndarray], margin: int = 2) -> np.ndarray:
+    """Mask (H, W) of the pixels within ``margin`` pixels of where each lamp centre
+    projects: a lamp smaller than a pixel is drawn box-filtered there (shading.glsl,
+    lamp_subpixel_cores), which this reference does not model."""
+    h, w = sc.height, sc.width
+    mask = np.zeros((h, w), dtype=bool)
+    aspect = w / h
+    for centre in centres:
+        rel = np.asarray(centre, dtype=np.float64) - sc.position
+        z = float(rel @ sc.forward)
+        if z <= 0:
+            continue
+        col = (float(rel @ sc.right) / (z * sc.tan_half * aspect) + 1.0) / 2.0 * w - 0.5
+        row = (1.0 - float(rel @ sc.up) / (z * sc.tan_half)) / 2.0 * h - 0.5
+        r0, r1 = int(np.floor(row)) - margin, int(np.ceil(row)) + margin
+        c0, c1 = int(np.floor(col)) - margin, int(np.ceil(col)) + margin
+        if r1 < 0 or c1 < 0 or r0 >= h or c0 >= w:
+            continue
+        mask[max(r0, 0):min(r1, h - 1) + 1, max(c0, 0):min(c1, w - 1) + 1] = True
+    return mask
+
+
 def smooth_pixels(sc: Scene, lamp_gap: float = 2.0) -> tuple[np.ndarray, Trace]:
     """Mask (H, W) of pixels away from geometric edges, shadow boundaries and lamp cores:
-    the whole 3x3 neighbourhood sees the same surface face with the same lit state, and
-    no ray of it passes within ``lamp_gap`` lamp radii of a lamp centre (the film border
-    is excluded). Also returns the trace of every pixel."""
+    the whole 3x3 neighbourhood sees the same surface face with the same lit state, no
+    ray of it passes within ``lamp_gap`` lamp radii of a lamp centre, and none is near
+    a lamp core smaller than a pixel (the film border is excluded). Also returns the
+    trace of every pixel."""
     h, w = sc.height, sc.width
     tr = trace(sc, camera_rays(sc))
     keys = [tr.hit_id.reshape(h, w)]
     keys += [tr.lit[j].reshape(h, w).astype(np.int64) for j in range(len(sc.lights))]
     near_lamp = (tr.min_lamp_gap < lamp_gap).reshape(h, w) | (tr.hit_id >= LAMP_BASE).reshape(h, w)
+    near_lamp |= subpixel_core_pixels(sc, [light.position for light in sc.lights])
     inner = np.ones((h - 2, w - 2), dtype=bool)
     for dy in (-1, 0, 1):
         for dx in (-1, 0, 1):

@@ -25,6 +25,7 @@ this one to float32 accuracy.
 from __future__ import annotations
 
 import json
+import math
 from collections.abc import Mapping
 from dataclasses import dataclass
 from typing import Any
@@ -291,9 +292,21 @@ def render_reference(scene: Any, width: int | None = None, height: int | None = 
     hit_id = np.full(n, BACKGROUND_ID, dtype=np.int64)
     hit_id[sees_surface] = index[sees_surface] * _FACES_PER_SURFACE + face[sees_surface]
     hit_id[sees_lamp] = LAMP_ID_BASE + lamp[sees_lamp]
+    # Lamps smaller than a pixel are drawn box-filtered around where their centre
+    # projects (shading.glsl, lamp_subpixel_cores), which this reference does not
+    # model: the 5 x 5 pixels there get the lamp's id, so smooth_mask leaves them out.
+    hit_id = hit_id.reshape(h, w)
+    pixel_angle = 2.0 * math.tan(math.radians(sc["camera"]["fov_y"]) / 2.0) / h
+    for j, light in enumerate(lights):
+        to_lamp = light.position - origin
+        best = int(np.argmax(d @ (to_lamp / np.linalg.norm(to_lamp))))
+        if float(d[best] @ to_lamp) < np.linalg.norm(to_lamp) * math.cos(2.0 * pixel_angle):
+            continue  # outside the picture
+        row, col = divmod(best, w)
+        hit_id[max(row - 2, 0):row + 3, max(col - 2, 0):col + 3] = LAMP_ID_BASE + j
     return ReferenceImage(
         radiance=radiance.reshape(h, w, 3),
-        hit_id=hit_id.reshape(h, w),
+        hit_id=hit_id,
         lit=lit.reshape(len(lights), h, w),
         t_hit=t_hit.reshape(h, w),
     )

@@ -65,7 +65,8 @@ def test_fov_y_is_the_full_vertical_angle_so_edge_directions_land_on_edge_rows(
     # lamp is distance / cos(half) away and a pixel there spans an angle of
     # tan(half) cos(half)^2 * 2 / height.
     pixel = distance * math.cos(half) * (2.0 * math.tan(half) / height)
-    lamps = [_lamp((0.0, y, -distance), radius=0.7 * pixel) for y in (edge, -edge)]
+    # Lamps smaller than a pixel are box-filtered around their centre: 0.3 pixel keeps each in one pixel.
+    lamps = [_lamp((0.0, y, -distance), radius=0.3 * pixel) for y in (edge, -edge)]
     img = renderer.render(_lamp_scene(lamps, width, height, fov_y))
     rows, cols = _lit_pixels(img)
     assert set(rows.tolist()) == {0, height - 1}, f"lamps on the edge directions lit rows {sorted(set(rows))}"
@@ -78,7 +79,7 @@ def test_aspect_ratio_comes_from_the_film_so_horizontal_edges_land_on_edge_colum
     half_x = math.atan(math.tan(math.radians(fov_y) / 2.0) * width / height)
     edge = distance * math.tan(half_x)
     pixel = distance * math.cos(half_x) * (2.0 * math.tan(half_x) / width)
-    lamps = [_lamp((x, 0.0, -distance), radius=0.7 * pixel) for x in (edge, -edge)]
+    lamps = [_lamp((x, 0.0, -distance), radius=0.3 * pixel) for x in (edge, -edge)]
     img = renderer.render(_lamp_scene(lamps, width, height, fov_y))
     rows, cols = _lit_pixels(img)
     assert set(cols.tolist()) == {0, width - 1}

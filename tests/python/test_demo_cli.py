@@ -182,3 +182,53 @@ def test_demo_auto_backend_falls_back_to_cpu_where_gl_is_unavailable(
     assert proc.returncode == 0, proc.stderr
     assert "cpu" in proc.stdout
     assert out.is_file()
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["--pupil", "0.5"], "--pupil"),
+    (["--pupil", "12"], "--pupil"),
+    (["--pupil", "wide"], "--pupil"),
+    (["--tonemap", "aces"], "--tonemap"),
+    (["--white", "0"], "--white"),
+    (["--white", "-2"], "--white"),
+    (["--sequence", "parade"], "--sequence"),
+    (["--sequence", "approaching-car", "--frames", "1"], "--frames"),
+    (["--sequence", "approaching-car", "--from", "10", "--to", "20"], "--to"),
+])
+def test_demo_bad_display_option_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
+                                                             args: list[str], needle: str) -> None:
+    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / "x.png"), *args)
+    _assert_one_line_error(proc, needle)
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_demo_bad_display_object_in_the_scene_names_the_field(tmp_path: Path, scene_factory) -> None:
+    path = _write_scene(tmp_path, scene_factory(display={"glare": {"pupil_diameter": 11}}))
+    _assert_one_line_error(_demo("--scene", str(path), "--out", str(tmp_path / "x.png")),
+                           "display.glare.pupil_diameter")
+
+
+def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str) -> None:
+    """The headlight experiment: one PNG per distance, named by frame and distance; at 2 km
+    the two headlights are one spot in the middle, at 20 m two spots either side of a
+    darker middle (1.5 m apart: 5.5 pixels each side at 14 degrees over 36 rows). Pixels 10
+    times the scene's on a side hold 100 times the solid angle: exposure 1, not 0.01."""
+    scene = Path(__file__).resolve().parents[2] / "scenes" / "approaching_car.json"
+    out = tmp_path / "frames"
+    proc = _demo("--scene", str(scene), "--out", str(out), "--backend", backend, "--sequence",
+                 "approaching-car", "--frames", "3", "--width", "64", "--height", "36", "--exposure", "1")
+    assert proc.returncode == 0, proc.stderr
+    assert proc.stdout.count("glare") == 3
+    names = sorted(p.name for p in out.iterdir())
+    assert names == ["frame_00_2000m.png", "frame_01_0200m.png", "frame_02_0020m.png"]
+    rows = []
+    for name in names:
+        with Image.open(out / name) as png:
+            pixels = np.asarray(png.convert("RGB")).astype(int)
+        assert pixels.shape == (36, 64, 3)
+        rows.append(pixels[16:20, :, 1].max(axis=0))
+    far, near = rows[0], rows[2]
+    assert far[30:34].max() > 150 and far[30:34].max() == far.max(), far.tolist()
+    left, right = int(np.argmax(near[:32])), 32 + int(np.argmax(near[32:]))
+    assert 24 <= left <= 29 and 35 <= right <= 40, near.tolist()
+    assert near[31:33].max() < 0.8 * min(near[left], near[right]), near.tolist()

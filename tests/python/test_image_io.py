@@ -152,27 +152,39 @@ def scene_file(tmp_path: Path, scene_factory) -> Path:
     return path
 
 
-def test_demo_png_equals_to_srgb8_of_the_cpu_render(tmp_path: Path, scene_file: Path) -> None:
+def test_demo_png_is_the_display_stage_of_the_cpu_render(tmp_path: Path, scene_file: Path) -> None:
     out = tmp_path / "x.png"
     proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "64",
                  "--height", "48")
     assert proc.returncode == 0, proc.stderr
     with Image.open(out) as png:
         decoded = np.asarray(png.convert("RGB"))
-    expected = airlight.to_srgb8(airlight.render(str(scene_file), backend="cpu", width=64, height=48), 1.0)
+    radiance = airlight.render(str(scene_file), backend="cpu", width=64, height=48)
+    expected = airlight.display_scene(radiance, str(scene_file))
     assert decoded.shape == (48, 64, 3)
     np.testing.assert_array_equal(decoded, expected)
     assert 0 < expected.mean() < 255
 
 
-def test_demo_png_applies_exposure(tmp_path: Path, scene_file: Path) -> None:
+@pytest.mark.parametrize(("flags", "kwargs"), [
+    (["--exposure", "4"], {"exposure": 4.0}),
+    (["--exposure", "0.5", "--tonemap", "filmic", "--white", "3"],
+     {"exposure": 0.5, "tonemap": "filmic", "white": 3.0}),
+    (["--tonemap", "linear", "--glare", "--pupil", "3"],
+     {"tonemap": "linear", "glare": {"pupil_diameter": 3.0}}),
+    (["--eyelashes"], {"glare": {"pupil_diameter": "auto", "eyelashes": True}}),
+])
+def test_demo_png_applies_the_display_flags(tmp_path: Path, scene_file: Path, flags: list[str],
+                                            kwargs: dict) -> None:
     out = tmp_path / "x.png"
     proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "32",
-                 "--height", "24", "--exposure", "4")
+                 "--height", "24", *flags)
     assert proc.returncode == 0, proc.stderr
     with Image.open(out) as png:
         decoded = np.asarray(png.convert("RGB"))
-    expected = airlight.to_srgb8(airlight.render(str(scene_file), backend="cpu", width=32, height=24), 4.0)
+    radiance = airlight.render(str(scene_file), backend="cpu", width=32, height=24)
+    fov = airlight.load_scene(str(scene_file))["camera"]["fov_y"]
+    expected = airlight.display(radiance, fov_y=fov, **kwargs)
     np.testing.assert_array_equal(decoded, expected)
 
 
