@@ -724,21 +724,13 @@ void check_display_image(const Image* image) {
 // The fp32 glare's measured error bound (see GlBackend::display).
 constexpr double kGlareFp32Error = 1e-6;
 
-// Upper bound on the change of an 8-bit display value (in [0, 1]) per unit
-// change of one exposed channel: the sRGB OETF's steepest slope 12.92 times
-// the tone curve's largest gain f(L) / L (display.glsl step 3), sampled on a
-// log grid over 1e-6..1e3 times the white point (steps of 10^(1/8); the
-// 1/8-step margin of glare_needs_double covers the sampling).
+// Upper bound on the change of a display value (in [0, 1]) per unit change
+// of one exposed grey value, at any level (DisplaySlope, display.hpp).
 double display_slope_bound(int curve_id, float white) {
     // shader::TONE_LINEAR, TONE_LOGLOG, TONE_REINHARD, TONE_FILMIC are 0..3 in ToneCurve's order.
     const ToneCurve curves[] = {ToneCurve::linear, ToneCurve::loglog, ToneCurve::reinhard, ToneCurve::filmic};
     const ToneCurve curve = curve_id >= 1 && curve_id <= 3 ? curves[curve_id] : ToneCurve::linear;
-    double gain = 0.0;
-    for (int k = -48; k <= 24; ++k) {
-        const double L = double(white) * std::pow(10.0, k / 8.0);
-        gain = std::max(gain, double(tone_map_luminance(curve, float(L), white)) / L);
-    }
-    return 12.92 * gain;
+    return DisplaySlope(curve, white).at_least(0.0);  // the steepest slope at any level
 }
 
 // True when the fp32 glare's noise, kGlareFp32Error * max |image| spread over

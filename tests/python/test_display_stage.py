@@ -11,6 +11,8 @@ import math
 import numpy as np
 import pytest
 from conftest import make_scene
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 import airlight
 
@@ -233,3 +235,47 @@ def test_rayleigh_criterion_on_rendered_lamps(renderer, separation: float, peaks
     assert report["glare"] in ("sparse", "fft", "gl-fft")
     row = shown[height // 2 - 1: height // 2 + 1, :, 1].max(axis=0)
     assert _row_peaks(row) == peaks, row.tolist()
+
+
+# ---- property: the glare's shortcuts never show --------------------------------------------
+
+@st.composite
+def _glare_cases(draw: st.DrawFn) -> tuple[np.ndarray, dict]:
+    """Random scenes for the display stage: a smooth or noisy background of random level,
+    a few lamps of random brightness (some on the border, some non-finite), random curve,
+    exposure, pupil, eyelashes and field of view."""
+    height = draw(st.integers(8, 48))
+    width = draw(st.integers(8, 64))
+    rng = np.random.default_rng(draw(st.integers(0, 2**32 - 1)))
+    level = 10.0 ** draw(st.floats(-4, 2))
+    y, x = np.mgrid[0:height, 0:width]
+    period = draw(st.floats(2.0, 200.0))
+    background = level * (1.0 + draw(st.floats(0, 0.9)) * np.sin(x / period + y / (1.3 * period)))
+    image = np.repeat(background[..., None], 3, axis=2) * rng.uniform(0.5, 1.0, 3)
+    if draw(st.booleans()):
+        image *= 1.0 + draw(st.floats(0, 0.5)) * rng.random(image.shape)
+    for _ in range(draw(st.integers(0, 5))):
+        image[rng.integers(0, height), rng.integers(0, width)] = level * 10.0 ** draw(st.floats(0, 8))
+    if draw(st.booleans()):
+        image[rng.integers(0, height), rng.integers(0, width), rng.integers(0, 3)] = draw(
+            st.sampled_from([np.nan, np.inf, -np.inf, -1.0]))
+    kwargs = {
+        "tonemap": draw(st.sampled_from(airlight.TONEMAPS)),
+        "exposure": draw(st.one_of(st.just("auto"), st.floats(1e-3, 1e3).map(lambda e: e / level))),
+        "glare": {"pupil_diameter": draw(st.floats(1.0, 9.0)), "eyelashes": draw(st.booleans())},
+        "fov_y": draw(st.floats(0.5, 120.0)),
+    }
+    return image.astype(np.float32), kwargs
+
+
+@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@given(case=_glare_cases())
+def test_glare_shortcuts_never_move_a_value_by_more_than_one_step(case: tuple[np.ndarray, dict]) -> None:
+    image, kwargs = case
+    shown, report = airlight.display_report(image, **kwargs)
+    clean = np.where(np.isfinite(image), np.maximum(image, 0.0), np.where(image > 0, 3e38, 0.0))
+    spread = airlight.glare(clean.astype(np.float32), fov_y=kwargs["fov_y"],
+                            pupil_diameter=report["pupil_diameter"], eyelashes=kwargs["glare"]["eyelashes"])
+    reference = airlight.display(spread, exposure=report["exposure"], tonemap=kwargs["tonemap"])
+    diff = np.abs(shown.astype(int) - reference.astype(int))
+    assert diff.max() <= 1, (report, int(np.count_nonzero(diff > 1)))
