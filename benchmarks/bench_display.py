@@ -4,8 +4,10 @@ on both backends, at 640x360 and 1920x1080, with and without glare.
     .venv/bin/python benchmarks/bench_display.py [--repeats 3] [--out docs/bench_display.txt]
 
 Scenes: ``foggy_street`` (street lamps in view: bright sources) and
-``fog_without_lamps_in_view``, the same street with its lamps moved behind the
-camera (the fog they light stays in view, smooth, with no core in the picture).
+``dense_fog_lamps_behind``, the same street in denser fog (sigma_t 0.15/m)
+with its lamps moved behind the camera: the fog they light fills the view,
+smooth, with no lamp core and only faint building edges (a scene without
+bright sources).
 Each radiance image is rendered once on the CPU; then each backend's display
 stage runs ``--repeats`` times after one warm-up call (which builds the glare
 kernel and, on GL, compiles the programs and caches the kernel's spectrum) and
@@ -37,9 +39,10 @@ GLARE = {"pupil_diameter": 4.0, "eyelashes": True}
 def scenes() -> dict[str, dict[str, Any]]:
     street = airlight.preset("foggy_street")
     behind = airlight.preset("foggy_street")
+    behind["medium"]["sigma_t"] = 0.15
     for light in behind["lights"]:
         light["position"][2] = 6.0 + abs(light["position"][2]) * 0.1  # behind the camera (it looks down -z)
-    return {"foggy_street": street, "fog_without_lamps_in_view": behind}
+    return {"foggy_street": street, "dense_fog_lamps_behind": behind}
 
 
 def time_display(radiance: np.ndarray, fov: float, glare: Any, renderer: airlight.Renderer | None,

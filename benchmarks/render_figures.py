@@ -12,7 +12,7 @@
   display stage with automatic exposure, the double-logarithmic curve and the
   glare of a 4 mm pupil with eyelashes, by the demo;
 - approaching_car.png: the headlight experiment (airlight-demo --sequence
-  approaching-car), the middle of 7 frames from 2 km to 20 m side by side.
+  approaching-car), the middle of 9 frames from 2 km to 20 m side by side.
 
 The first figures use the linear curve (``--tonemap linear``) with the
 exposures above, as before the display stage existed.
@@ -47,18 +47,18 @@ def demo(scene: str, out: Path, backend: str, *flags: str) -> None:
 
 
 def approaching_car_strip(backend: str, out: Path) -> None:
-    """The headlight experiment's frames (80 x 32 pixels around the car, enlarged 3 times),
+    """The headlight experiment's 9 frames (128 x 40 pixels around the car, enlarged twice),
     side by side from 2 km (left) to 20 m (right)."""
     with tempfile.TemporaryDirectory() as tmp:
-        demo("approaching_car", Path(tmp), backend, "--sequence", "approaching-car", "--frames", "7")
+        demo("approaching_car", Path(tmp), backend, "--sequence", "approaching-car", "--frames", "9")
         tiles = []
         for path in sorted(Path(tmp).glob("frame_*.png")):
             with Image.open(path) as png:
                 frame = np.asarray(png.convert("RGB"))
             h, w = frame.shape[:2]
-            crop = frame[h // 2 - 16:h // 2 + 16, w // 2 - 40:w // 2 + 40]
-            tiles.append(np.asarray(Image.fromarray(crop).resize((240, 96), Image.NEAREST)))
-            tiles.append(np.full((96, 4, 3), 60, np.uint8))
+            crop = frame[h // 2 - 20:h // 2 + 20, w // 2 - 64:w // 2 + 64]
+            tiles.append(np.asarray(Image.fromarray(crop).resize((256, 80), Image.NEAREST)))
+            tiles.append(np.full((80, 4, 3), 60, np.uint8))
     Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 

@@ -1003,16 +1003,4 @@ Image convolve_glare_direct(const Image& image, const GlareKernel& kernel, int t
     return out;
 }
 
-double glare_change_bound(const Image& image, const GlareKernel& kernel) {
-    std::array<double, 3> vmax{0.0, 0.0, 0.0};
-    for (size_t i = 0; i < image.rgb.size(); ++i) vmax[i % 3] = std::max(vmax[i % 3], std::abs(double(image.rgb[i])));
-    double bound = 0.0;
-    for (int c = 0; c < 3; ++c) bound = std::max(bound, vmax[c] * (1.0 - kernel.centre(c)));
-    return bound;
-}
-
-bool glare_needed(const Image& image, const GlareKernel& kernel, double display_white, double tolerance) {
-    return glare_change_bound(image, kernel) > tolerance * display_white;
-}
-
 }  // namespace airlight

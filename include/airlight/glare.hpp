@@ -112,16 +112,6 @@ GlareKernel glare_kernel_rgb(const GlareOptions& options, double pixel_angle);
 Image convolve_glare_fft(const Image& image, const GlareKernel& kernel, int threads = 0);
 Image convolve_glare_direct(const Image& image, const GlareKernel& kernel, int threads = 0);
 
-// Bound on how much glare can change any pixel of this image, per channel
-// maximum of v_max (1 - k_centre): the kernel moves at most the fraction
-// 1 - k_centre of a pixel's light elsewhere, and gathers into a pixel at most
-// v_max times the kernel's off-centre weight.
-double glare_change_bound(const Image& image, const GlareKernel& kernel);
-
-// False when skipping the glare changes no pixel by more than
-// tolerance * display_white (the bound above); then leave the image as is.
-bool glare_needed(const Image& image, const GlareKernel& kernel, double display_white, double tolerance = 1e-3);
-
 // Internal pieces, exposed for the tests.
 namespace detail {
 // In-place mixed-radix FFT (Stockham autosort, radices 4, 2, 3, 5); the size
