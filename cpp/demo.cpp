@@ -18,7 +18,7 @@
 
 #ifdef AIRLIGHT_HAVE_GLFW
 namespace airlight {
-int run_window(Scene scene, Backend backend, float exposure);  // demo_window.cpp
+int run_window(Scene scene, Backend backend, DisplaySettings display);  // demo_window.cpp
 }
 #endif
 
@@ -258,11 +258,7 @@ int main(int argc, char** argv) {
         if (!o.sequence.empty()) return run_sequence(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
-            const float exposure =
-                o.exposure.empty() || o.exposure == "auto"
-                    ? (scene.display.exposure_mode == ExposureMode::manual ? scene.display.exposure : 1.0f)
-                    : std::strtof(o.exposure.c_str(), nullptr);
-            return run_window(scene, backend, exposure);
+            return run_window(scene, backend, display_settings(scene, o));
 #else
             fail("--window needs a build with GLFW");
 #endif

@@ -1,7 +1,9 @@
 // airlight-demo --window: an interactive view (needs GLFW and a display).
 // W/A/S/D move, Q/E down/up, arrow keys turn, +/- exposure, Esc quits. Each
-// frame is rendered by a Renderer (GL or CPU backend) and shown as a texture.
-#include "airlight/image_io.hpp"
+// frame is rendered by a Renderer (GL or CPU backend), passed through the
+// display stage (the scene's display settings: exposure, glare, tone curve)
+// on the same backend, and shown as a texture.
+#include "airlight/display.hpp"
 #include "airlight/renderer.hpp"
 
 #define GLFW_INCLUDE_NONE
@@ -50,7 +52,7 @@ GLuint build_blit_program() {
 
 }  // namespace
 
-int run_window(Scene scene, Backend backend, float exposure) {
+int run_window(Scene scene, Backend backend, DisplaySettings display) {
     if (!glfwInit()) throw std::runtime_error("cannot open a window (no display?)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
@@ -73,6 +75,7 @@ int run_window(Scene scene, Backend backend, float exposure) {
     float pitch = std::asin(glm::clamp(forward.y, -1.0f, 1.0f));
     double last = glfwGetTime();
     int tex_w = 0, tex_h = 0;
+    float shown_exposure = display.exposure;  // the exposure of the last frame shown
     while (!glfwWindowShouldClose(window)) {
         glfwPollEvents();
         const double now = glfwGetTime();
@@ -90,24 +93,28 @@ int run_window(Scene scene, Backend backend, float exposure) {
         pos += forward * speed * ((down(GLFW_KEY_W) ? 1.0f : 0.0f) - (down(GLFW_KEY_S) ? 1.0f : 0.0f));
         pos += right * speed * ((down(GLFW_KEY_D) ? 1.0f : 0.0f) - (down(GLFW_KEY_A) ? 1.0f : 0.0f));
         pos.y += speed * ((down(GLFW_KEY_E) ? 1.0f : 0.0f) - (down(GLFW_KEY_Q) ? 1.0f : 0.0f));
-        if (down(GLFW_KEY_EQUAL)) exposure *= 1.0f + dt;
-        if (down(GLFW_KEY_MINUS)) exposure /= 1.0f + dt;
+        if (down(GLFW_KEY_EQUAL) || down(GLFW_KEY_MINUS)) {
+            // From automatic exposure, +/- start at the exposure it chose.
+            display.exposure_mode = ExposureMode::manual;
+            display.exposure = shown_exposure * (down(GLFW_KEY_EQUAL) ? 1.0f + dt : 1.0f / (1.0f + dt));
+        }
         scene.camera.look_at = pos + forward;
         scene.camera.up = glm::vec3(0, 1, 0);
 
         const Image image = renderer.render(scene);
+        const DisplayImage shown = renderer.display(image, display, scene.camera.fov_y_degrees);
+        shown_exposure = shown.report.exposure;
         glfwMakeContextCurrent(window);  // the GL backend switches to its own context
-        std::vector<float> scaled(image.rgb);
-        for (float& v : scaled) v = linear_to_srgb(v * exposure);
-        if (image.width != tex_w || image.height != tex_h) {
+        if (shown.width != tex_w || shown.height != tex_h) {
             if (texture != 0) glDeleteTextures(1, &texture);
             glCreateTextures(GL_TEXTURE_2D, 1, &texture);
-            glTextureStorage2D(texture, 1, GL_RGB32F, image.width, image.height);
+            glTextureStorage2D(texture, 1, GL_RGB8, shown.width, shown.height);
             glTextureParameteri(texture, GL_TEXTURE_MIN_FILTER, GL_LINEAR);
-            tex_w = image.width;
-            tex_h = image.height;
+            tex_w = shown.width;
+            tex_h = shown.height;
         }
-        glTextureSubImage2D(texture, 0, 0, 0, image.width, image.height, GL_RGB, GL_FLOAT, scaled.data());
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 1);  // rows of 3-byte pixels
+        glTextureSubImage2D(texture, 0, 0, 0, shown.width, shown.height, GL_RGB, GL_UNSIGNED_BYTE, shown.srgb8.data());
         int fb_w = 0, fb_h = 0;
         glfwGetFramebufferSize(window, &fb_w, &fb_h);
         glViewport(0, 0, fb_w, fb_h);
