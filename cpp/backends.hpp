@@ -24,6 +24,10 @@ struct GlDisplayJob {
     int curve = 0;                       // shader::TONE_*
     float white = 1.0f;                  // > 0
     const GlareKernel* glare = nullptr;  // null: no glare
+    // Optional radiance of the same size added after the glare convolution,
+    // before display_pixel (the splatted glare of the few extreme pixels that
+    // the FFT does not see; glare_exact_split in display_stage.cpp).
+    const Image* addend = nullptr;
 };
 
 // What the GL display pass returns: RGB bytes, row 0 on top, as

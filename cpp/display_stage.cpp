@@ -95,47 +95,91 @@ Image crop(const Image& image, int x0, int y0, int width, int height) {
     return out;
 }
 
+GlareSplit split_for_fft(Image image, const GlareKernel& kernel) {
+    GlareSplit split;
+    for (float& v : image.rgb) v = sanitised(v);
+    std::vector<float> values;
+    values.reserve(image.rgb.size());
+    for (float v : image.rgb)
+        if (v > 0.0f) values.push_back(v);
+    if (values.empty()) {
+        split.clipped = std::move(image);
+        return split;
+    }
+    // C = 1e4 x the median of the positive channel values.
+    auto median = values.begin() + std::ptrdiff_t(values.size() / 2);
+    std::nth_element(values.begin(), median, values.end());
+    const float cap = std::min(1e4f * *median, 1e30f);
+    bool any = false;
+    split.excess = Image{image.width, image.height, std::vector<float>(image.rgb.size(), 0.0f)};
+    for (int y = 0; y < image.height; ++y) {
+        for (int x = 0; x < image.width; ++x) {
+            for (int c = 0; c < 3; ++c) {
+                float& v = image.rgb[(size_t(y) * image.width + x) * 3 + c];
+                if (v <= cap) continue;
+                splat(split.excess, kernel, x, y, c, double(v) - double(cap));
+                v = cap;
+                any = true;
+            }
+        }
+    }
+    if (!any) split.excess = Image{};
+    split.clipped = std::move(image);
+    return split;
+}
+
 Image glare_exact(const Image& linear, const GlareKernel& kernel, int threads) {
     if (linear.width < 1 || linear.height < 1) return linear;
     const int r = kernel.radius;
-    Image ext = extend_edges(linear, r);
-    for (float& v : ext.rgb) v = sanitised(v);
-    return crop(convolve_glare_fft(ext, kernel, threads), r, r, linear.width, linear.height);
+    const GlareSplit split = split_for_fft(extend_edges(linear, r), kernel);
+    Image out = convolve_glare_fft(split.clipped, kernel, threads);
+    if (!split.excess.rgb.empty())
+        for (size_t i = 0; i < out.rgb.size(); ++i) out.rgb[i] += split.excess.rgb[i];
+    return crop(out, r, r, linear.width, linear.height);
 }
 
-DisplaySlope::DisplaySlope(ToneCurve curve, float white) {
-    // 64 samples per decade over [1e-8, 1e3] x white: finite differences of
-    // the grey response g(y) = srgb_oetf(f(y)), then the running maximum from
-    // the top (the envelope). Below the grid the slope is the bottom value:
-    // every curve is linear there (f(y) ~ f'(0) y, sRGB linear below 0.0031).
+DisplayResponse::DisplayResponse(ToneCurve curve, float white) : curve_id_(tone_curve_shader_id(curve)), white_(white) {
     const int per_decade = 64, decades = 11;
     const int n = per_decade * decades + 1;
     log_lo_ = std::log(double(white) * 1e-8);
     step_ = std::log(10.0) / per_decade;
-    const int id = tone_curve_shader_id(curve);
-    auto g = [&](double y) { return double(shader::srgb_oetf(shader::tone_curve(id, float(y), white))); };
-    std::vector<double> slope(size_t(n), 0.0);
-    for (int k = 0; k + 1 < n; ++k) {
-        const double y0 = std::exp(log_lo_ + step_ * k), y1 = std::exp(log_lo_ + step_ * (k + 1));
-        slope[size_t(k)] = std::max(0.0, (g(y1) - g(y0)) / (y1 - y0));
-    }
-    // Secant slopes of a concave piece understate the tangent at its left end
-    // by at most the ratio of neighbouring secants; a factor 1.25 covers the
-    // grid's 3.7 % steps with margin (and the float rounding of g).
-    envelope_.assign(size_t(n), 0.0);
-    double running = 0.0;
+    gain_envelope_.assign(size_t(n), 0.0);
+    bend_envelope_.assign(size_t(n), 0.0);
+    double g_max = 0.0, h_max = 0.0;
+    const double half = 0.5 * step_;
     for (int k = n - 1; k >= 0; --k) {
-        running = std::max(running, 1.25 * slope[size_t(k)]);
-        envelope_[size_t(k)] = running;
+        const double y = std::exp(log_lo_ + step_ * k);
+        const double y0 = y * std::exp(-half), y1 = y * std::exp(half);
+        const double f0 = double(shader::tone_curve(curve_id_, float(y0), white_));
+        const double f1 = double(shader::tone_curve(curve_id_, float(y1), white_));
+        const double slope = (f1 - f0) / (y1 - y0);  // f'(y), central difference
+        g_max = std::max(g_max, gain(y));
+        h_max = std::max(h_max, std::abs(slope - gain(y)));
+        gain_envelope_[size_t(k)] = 1.05 * g_max;
+        bend_envelope_[size_t(k)] = 1.05 * h_max;
     }
 }
 
-double DisplaySlope::at_least(double exposed) const {
-    if (!(exposed > 0.0)) return envelope_.front();
-    const double k = (std::log(exposed) - log_lo_) / step_;
-    if (k <= 0.0) return envelope_.front();
+double DisplayResponse::gain(double y) const {
+    // Below 1e-8 white every curve is linear (f(y) ~ f'(0) y); g is taken there.
+    const double lo = double(white_) * 1e-8;
+    const double at = std::max(y, lo);
+    return double(shader::tone_curve(curve_id_, float(at), white_)) / at;
+}
+
+double DisplayResponse::envelope(const std::vector<double>& table, double y) const {
+    const double k = y > 0.0 ? (std::log(y) - log_lo_) / step_ : -1.0;
+    if (k <= 0.0) return table.front();
     const size_t i = size_t(k);
-    return i >= envelope_.size() ? 0.0 : envelope_[i];
+    return i >= table.size() ? table.back() : table[i];  // beyond 1e3 white: g, |f' - g| <= 1e-3 / white
+}
+
+double DisplayResponse::sensitivity(double c_lo, double y_lo, double y_hi, double chroma) const {
+    // sRGB's slope at the darkest display value the tile can take (IEC 61966-2-1).
+    const double u = std::max(c_lo, 0.0) * gain(std::max(y_hi, 0.0));
+    const double srgb_slope = u >= 1.0 ? 0.0 : (u <= 0.0031308 ? 12.92 : 1.055 / 2.4 * std::pow(u, -1.4 / 2.4));
+    const double y = std::max(y_lo, 0.0);
+    return srgb_slope * (envelope(gain_envelope_, y) + chroma * envelope(bend_envelope_, y));
 }
 
 namespace {
@@ -148,6 +192,8 @@ struct TileRanges {
     int nx = 0, ny = 0;
     std::vector<std::array<float, 3>> hi, lo;
     std::vector<float> step;
+    std::vector<float> y_lo, y_hi;  // Rec. 709 luminance
+    std::vector<float> chroma;      // max over pixels and channels of c / Y (0 where Y = 0)
 };
 
 // The kernel's off-centre weight by L1 distance k = |dx| + |dy| (index k,
@@ -189,6 +235,9 @@ TileRanges tile_ranges(const Image& image, int tile) {
     t.hi.assign(size_t(t.nx) * t.ny, {0.0f, 0.0f, 0.0f});
     t.lo.assign(size_t(t.nx) * t.ny, {1e30f, 1e30f, 1e30f});
     t.step.assign(size_t(t.nx) * t.ny, 0.0f);
+    t.y_lo.assign(size_t(t.nx) * t.ny, 1e30f);
+    t.y_hi.assign(size_t(t.nx) * t.ny, 0.0f);
+    t.chroma.assign(size_t(t.nx) * t.ny, 0.0f);
     const int w = image.width, h = image.height;
     for (int y = 0; y < h; ++y) {
         const size_t row = size_t(y / tile) * t.nx;
@@ -197,6 +246,11 @@ TileRanges tile_ranges(const Image& image, int tile) {
             const float* right = x + 1 < w ? p + 3 : p;
             const float* below = y + 1 < h ? p + size_t(w) * 3 : p;
             const size_t i = row + size_t(x / tile);
+            const float r = sanitised(p[0]), g = sanitised(p[1]), b = sanitised(p[2]);
+            const float lum = 0.2126f * r + 0.7152f * g + 0.0722f * b;
+            t.y_lo[i] = std::min(t.y_lo[i], lum);
+            t.y_hi[i] = std::max(t.y_hi[i], lum);
+            if (lum > 0.0f) t.chroma[i] = std::max(t.chroma[i], std::max({r, g, b}) / lum);
             for (int c = 0; c < 3; ++c) {
                 const float v = sanitised(p[c]);
                 t.hi[i][c] = std::max(t.hi[i][c], v);
@@ -213,7 +267,7 @@ TileRanges tile_ranges(const Image& image, int tile) {
 // tiles, whose values extend_edges repeats), with the slope test: returns e_t
 // when e_t * exposure * slope <= half a step, else a negative value.
 double tile_bound(const TileRanges& t, const std::vector<double>& caps, int tx, int ty, double cap,
-                  const KernelProfile& profile, double exposure, const DisplaySlope& slope) {
+                  const KernelProfile& profile, double exposure, const DisplayResponse& response) {
     constexpr double kHalfStep = 0.5 / 255.0;
     std::array<double, 3> hi{0.0, 0.0, 0.0}, lo{1e30, 1e30, 1e30};
     double step = 0.0;
@@ -232,14 +286,26 @@ double tile_bound(const TileRanges& t, const std::vector<double>& caps, int tx, 
         }
     }
     const size_t own = size_t(ty) * t.nx + tx;
+    const double own_cap = std::min(caps[own], cap);
     double range = 0.0, own_low = 1e30;
     for (int c = 0; c < 3; ++c) {
         range = std::max(range, hi[c] - lo[c]);
-        own_low = std::min(own_low, std::min(double(t.lo[own][c]), std::min(caps[own], cap)));
+        own_low = std::min(own_low, std::min(double(t.lo[own][c]), own_cap));
     }
     const double e = clipped ? profile.spread * range : glare_change_bound(profile, step, range);
-    const double level = exposure * std::max(own_low - e, 0.0);
-    return e * exposure * slope.at_least(level) > kHalfStep ? -1.0 : e;
+    // The tile's levels after a change of at most e (clipping at own_cap lowers luminance at most to
+    // own_cap's and can raise the chroma to 1 / 0.0722, the bluest possible).
+    const bool own_clipped = double(std::max({t.hi[own][0], t.hi[own][1], t.hi[own][2]})) > own_cap;
+    const double c_lo = exposure * (own_low - e);
+    const double y_lo = exposure * (std::min(double(t.y_lo[own]), own_cap) - e);
+    const double y_hi = exposure * (std::min(double(t.y_hi[own]), own_cap) + e);
+    // c / Y <= 1 / 0.0722 always (Y >= 0.0722 c); after the change, (c + e) / (Y - e).
+    constexpr double kMaxChroma = 1.0 / 0.0722;
+    const double raw_y_lo = std::min(double(t.y_lo[own]), own_cap);
+    const double chroma = own_clipped || raw_y_lo <= e
+                              ? kMaxChroma
+                              : std::min(kMaxChroma, (double(t.chroma[own]) * raw_y_lo + e) / (raw_y_lo - e));
+    return e * exposure * response.sensitivity(c_lo, y_lo, y_hi, chroma) > kHalfStep ? -1.0 : e;
 }
 
 // Per-tile thresholds (GlarePlan::tile_threshold): start with none (every
@@ -250,10 +316,10 @@ double tile_bound(const TileRanges& t, const std::vector<double>& caps, int tx, 
 // lowered cap can lower a neighbourhood's minimum). Returns false when it
 // has not settled after `rounds` rounds.
 bool choose_tile_thresholds(const TileRanges& t, double top, const KernelProfile& spread, double exposure,
-                            const DisplaySlope& slope, std::vector<double>& caps, double& worst) {
+                            const DisplayResponse& slope, std::vector<double>& caps, double& worst) {
     const double none = top * 2.0 + 1.0;
     caps.assign(size_t(t.nx) * t.ny, none);
-    for (int round = 0; round < 16; ++round) {
+    for (int round = 0; round < 64; ++round) {
         bool changed = false;
         worst = 0.0;
         for (int ty = 0; ty < t.ny; ++ty) {
@@ -312,7 +378,7 @@ GlarePlan plan_glare(const Image& linear, const DisplaySettings& settings, float
     const GlareKernel& kernel = *plan.kernel;
     const KernelProfile spread = kernel_profile(kernel);
     const float white = settings.white ? *settings.white : default_white(settings.curve);
-    const DisplaySlope slope(settings.curve, white);
+    const DisplayResponse slope(settings.curve, white);
     plan.tile = std::max(kernel.radius, 1);
     const TileRanges tiles = tile_ranges(linear, plan.tile);
     plan.tiles_x = tiles.nx;
@@ -422,7 +488,7 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
         // exact result, not the sparse split) and tone-maps it; the margin is
         // cropped from the bytes.
         GlDisplayJob job;
-        Image extended;
+        GlareSplit split;
         int margin = 0;
         job.linear = &linear;
         job.exposure = report.exposure;
@@ -430,9 +496,9 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
         job.white = report.white;
         if (plan.enabled && plan.sources > 0) {
             margin = plan.kernel->radius;
-            extended = extend_edges(linear, margin);
-            for (float& v : extended.rgb) v = sanitised(v);
-            job.linear = &extended;
+            split = split_for_fft(extend_edges(linear, margin), *plan.kernel);
+            job.linear = &split.clipped;
+            if (!split.excess.rgb.empty()) job.addend = &split.excess;
             job.glare = plan.kernel.get();
             report.glare = "gl-fft";
         }

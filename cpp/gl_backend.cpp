@@ -293,9 +293,9 @@ struct GlBackend::State {
     // ---- Display stage (GlBackend::display, glare_convolve).
     GLuint display_program = 0;
     std::map<int, GLuint> fft_programs;  // by pass * 4 + (shared memory line ? 2 : 0) + (double ? 1 : 0)
-    GLuint radiance_tex = 0, glare_tex = 0, display_tex = 0, kernel_tex = 0;
+    GLuint radiance_tex = 0, glare_tex = 0, display_tex = 0, kernel_tex = 0, addend_tex = 0;
     int radiance_w = 0, radiance_h = 0, glare_w = 0, glare_h = 0, display_w = 0, display_h = 0, kernel_w = 0,
-        kernel_h = 0;
+        kernel_h = 0, addend_w = 0, addend_h = 0;
     GLuint scratch_ssbo = 0;
     std::array<GLuint, 2> twiddle_ssbo{};  // [0] float, [1] double
     std::array<GLuint, 3> spectrum_ssbo{}, kernel_ssbo{};
@@ -393,6 +393,14 @@ struct GlBackend::State {
         glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
         glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
         glTextureSubImage2D(radiance_tex, 0, 0, 0, image.width, image.height, GL_RGB, GL_FLOAT, image.rgb.data());
+    }
+
+    // GlDisplayJob::addend into addend_tex (RGBA32F), like upload_radiance.
+    void upload_addend(const Image& image) {
+        ensure_texture(addend_tex, addend_w, addend_h, GL_RGBA32F, image.width, image.height);
+        glPixelStorei(GL_UNPACK_ALIGNMENT, 4);
+        glPixelStorei(GL_UNPACK_ROW_LENGTH, 0);
+        glTextureSubImage2D(addend_tex, 0, 0, 0, image.width, image.height, GL_RGB, GL_FLOAT, image.rgb.data());
     }
 
     // Runs `lines` work groups of `program` from line 0 in chunks of at most
@@ -578,7 +586,7 @@ struct GlBackend::State {
     }
 
     // display_pixel over the w x h texture `source` into display_tex (RGBA8).
-    void display_pass(GLuint source, int w, int h, float exposure, int curve, float white) {
+    void display_pass(GLuint source, int w, int h, float exposure, int curve, float white, bool has_addend) {
         if (display_program == 0) {
             display_program = link_compute_program(std::string(kGlslPrelude) + shader_source("display.glsl") +
                                                    shader_source("display_pass.comp"));
@@ -589,7 +597,9 @@ struct GlBackend::State {
         set_uniform(display_program, "u_exposure", exposure);
         set_uniform(display_program, "u_curve", curve);
         set_uniform(display_program, "u_white", white);
+        set_uniform(display_program, "u_has_addend", has_addend ? 1 : 0);
         glBindTextureUnit(0, source);
+        if (has_addend) glBindTextureUnit(1, addend_tex);
         glBindImageTexture(0, display_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
         glDispatchCompute(GLuint((w + 15) / 16), GLuint((h + 15) / 16), 1);
         glMemoryBarrier(GL_ALL_BARRIER_BITS);
@@ -629,8 +639,9 @@ GlBackend::~GlBackend() {
         glDeleteTextures(1, &state_->color);
         if (state_->display_program != 0) glDeleteProgram(state_->display_program);
         for (auto& entry : state_->fft_programs) glDeleteProgram(entry.second);
-        GLuint display_textures[] = {state_->radiance_tex, state_->glare_tex, state_->display_tex, state_->kernel_tex};
-        glDeleteTextures(4, display_textures);  // zero names are ignored
+        GLuint display_textures[] = {state_->radiance_tex, state_->glare_tex, state_->display_tex, state_->kernel_tex,
+                                     state_->addend_tex};
+        glDeleteTextures(5, display_textures);  // zero names are ignored
         GLuint display_buffers[] = {state_->twiddle_ssbo[0],  state_->twiddle_ssbo[1],  state_->scratch_ssbo,
                                     state_->spectrum_ssbo[0], state_->spectrum_ssbo[1], state_->spectrum_ssbo[2],
                                     state_->kernel_ssbo[0],   state_->kernel_ssbo[1],   state_->kernel_ssbo[2]};
@@ -725,12 +736,12 @@ void check_display_image(const Image* image) {
 constexpr double kGlareFp32Error = 1e-6;
 
 // Upper bound on the change of a display value (in [0, 1]) per unit change
-// of one exposed grey value, at any level (DisplaySlope, display.hpp).
+// of one exposed channel, at any level (DisplayResponse, display.hpp).
 double display_slope_bound(int curve_id, float white) {
     // shader::TONE_LINEAR, TONE_LOGLOG, TONE_REINHARD, TONE_FILMIC are 0..3 in ToneCurve's order.
     const ToneCurve curves[] = {ToneCurve::linear, ToneCurve::loglog, ToneCurve::reinhard, ToneCurve::filmic};
     const ToneCurve curve = curve_id >= 1 && curve_id <= 3 ? curves[curve_id] : ToneCurve::linear;
-    return DisplaySlope(curve, white).at_least(0.0);  // the steepest slope at any level
+    return DisplayResponse(curve, white).steepest();
 }
 
 // True when the fp32 glare's noise, kGlareFp32Error * max |image| spread over
@@ -790,8 +801,14 @@ void GlBackend::display(const GlDisplayJob& job, GlDisplayOutput& out) {
         out.glare_ms = ms_since(t0);
         source = s.glare_tex;
     }
+    const bool has_addend = job.addend != nullptr;
+    if (has_addend) {
+        if (job.addend->width != w || job.addend->height != h)
+            throw std::invalid_argument("display: the addend's size differs from the radiance's");
+        s.upload_addend(*job.addend);
+    }
     const auto t1 = std::chrono::steady_clock::now();
-    s.display_pass(source, w, h, job.exposure, job.curve, job.white);
+    s.display_pass(source, w, h, job.exposure, job.curve, job.white, has_addend);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     glGetTextureImage(s.display_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, GLsizei(out.srgb8.size()), out.srgb8.data());

@@ -8,17 +8,21 @@
 layout(local_size_x = 16, local_size_y = 16) in;
 
 layout(binding = 0) uniform sampler2D u_radiance;  // RGBA32F, texel row = image row
+layout(binding = 1) uniform sampler2D u_addend;    // RGBA32F, added to u_radiance when u_has_addend
 layout(rgba8, binding = 0) writeonly uniform image2D u_display;
 
 uniform ivec2 u_size;
 uniform float u_exposure;
 uniform int u_curve;
 uniform float u_white;
+uniform bool u_has_addend;
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
     if (p.x >= u_size.x || p.y >= u_size.y) return;
-    vec3 v = display_pixel(texelFetch(u_radiance, p, 0).rgb, u_exposure, u_curve, u_white);
+    vec3 radiance = texelFetch(u_radiance, p, 0).rgb;
+    if (u_has_addend) radiance += texelFetch(u_addend, p, 0).rgb;
+    vec3 v = display_pixel(radiance, u_exposure, u_curve, u_white);
     vec3 t = 255.0f * v;
     vec3 q = floor(t);
     q += vec3(greaterThanEqual(t - q, vec3(0.5f)));  // t - q is exact: lround for t >= 0

@@ -218,7 +218,9 @@ vec3 lamp_subpixel_cores(int x, int row, vec3 radiance) {
             int hit = -1;
             vec3 n;
             if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
-            radiance = mix(radiance, vec3(lamp.intensity) / (PI * r * r) * transmittance(d), cover);
+            // The weight can exceed 1 by the solid-angle ratio: the core's part stays exact, the
+            // hidden background's never goes negative.
+            radiance = radiance * max(1.0f - cover, 0.0f) + vec3(lamp.intensity) / (PI * r * r) * transmittance(d) * cover;
         }
     }
     if (HAS_SPOT_LIGHTS) {
@@ -233,7 +235,7 @@ vec3 lamp_subpixel_cores(int x, int row, vec3 radiance) {
             vec3 n;
             if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
             vec3 core = vec3(s.intensity_edge) * (spot_profile_toward(s, -rel / d) / (PI * r * r));
-            radiance = mix(radiance, core * transmittance(d), cover);
+            radiance = radiance * max(1.0f - cover, 0.0f) + core * transmittance(d) * cover;
         }
     }
     return radiance;

@@ -61,19 +61,35 @@ std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettin
 // the channels are taken as already photometrically weighted).
 constexpr double kLuminousEfficacy = 683.0;
 
-// The steepest response of a grey pixel's display value (in [0, 1], before
-// 8-bit rounding) to its exposed value, from `exposed` up: max over
-// y >= exposed of d/dy srgb_oetf(f(y)), f the tone curve (non-increasing in
-// `exposed`, so it bounds the slope over any interval starting there).
-// Tabulated on a log grid over [1e-8, 1e3] x white (display_stage.cpp).
-class DisplaySlope {
+// How much a display value (in [0, 1], before 8-bit rounding) can move when
+// every exposed channel of a pixel moves by at most delta. display_pixel
+// shows channel i as u_i = c_i g(Y), g(Y) = f(Y) / Y (f the tone curve, Y the
+// luminance), then sRGB. With |dc_j| <= delta, |dY| <= delta (the weights sum
+// to 1) and g' = (f' - g) / Y,
+//   |du_i| <= delta (g + c_i |g'|) = delta (g + (c_i / Y) |f' - g|),
+// and |dv_i| <= srgb'(u) |du_i| with srgb' decreasing in u. So for a tile
+// whose exposed values after the change stay in [c_lo, ...], luminance in
+// [Y_lo, Y_hi] and chroma c_i / Y <= chroma:
+//   |dv| <= delta * srgb'(c_lo g(Y_hi)) * (G(Y_lo) + chroma H(Y_lo)),
+// G(y) = max over y' >= y of g(y'), H likewise of |f' - g| (envelopes: the
+// filmic toe is convex, g is not monotonic there). Tabulated on 64 points per
+// decade over [1e-8, 1e3] x white (f' by central differences), with a 5 %
+// margin for the grid (display_stage.cpp).
+class DisplayResponse {
 public:
-    DisplaySlope(ToneCurve curve, float white);
-    double at_least(double exposed) const;
+    DisplayResponse(ToneCurve curve, float white);
+    // Bound on |dv| / delta for the tile described above (exposed units).
+    double sensitivity(double c_lo, double y_lo, double y_hi, double chroma) const;
+    // The largest sensitivity at any level and colour of chroma <= 1 (a grey pixel at 0).
+    double steepest() const { return sensitivity(0.0, 0.0, 0.0, 1.0); }
 
 private:
+    double gain(double y) const;  // g(y) = f(y) / y (f'(0) at 0)
+    double envelope(const std::vector<double>& table, double y) const;
+    int curve_id_ = 0;
+    float white_ = 1.0f;
     double log_lo_ = 0.0, step_ = 0.0;
-    std::vector<double> envelope_;
+    std::vector<double> gain_envelope_, bend_envelope_;  // G, H
 };
 
 // How the glare of one display run is done (plan_glare; docs/glare.md
@@ -113,9 +129,27 @@ struct GlarePlan {
 // The eye's glare as shown by the display stage: the image extended by
 // copies of its edge pixels (extend_edges: the world goes on past the frame,
 // so the border gathers glare from outside as it loses glare to it; a uniform
-// image is unchanged), convolved with the kernel (convolve_glare_fft),
-// cropped. NaN and negative radiance count as 0.
+// image is unchanged), convolved with the kernel, cropped. NaN and negative
+// radiance count as 0, +inf as 1e30 (as display_pixel takes them). The
+// convolution is split_for_fft's: the FFT's roundoff is about 1e-16 of its
+// input's maximum (6e-7 on the GPU in fp32), which a lamp 1e16 times its
+// surroundings (or an infinite pixel) would spread over the whole image, so
+// the FFT sees the image clipped at C = 1e4 times the median of its positive
+// values and the excess of the few pixels above (lamp cores) is splatted
+// exactly: the FFT's noise stays below 1e-12 (double) or 6e-3 (fp32) of the
+// median, and the GPU's fp32 path suffices unless the exposure makes the
+// median far brighter than white.
 Image glare_exact(const Image& linear, const GlareKernel& kernel, int threads = 0);
+
+// `image` (sanitised as above) clipped at C = 1e4 x the median of its
+// positive channel values, and the glare of the excess above it (splatted with
+// `kernel`, zero padding; empty when nothing is above): K * image =
+// K * clipped + excess.
+struct GlareSplit {
+    Image clipped;
+    Image excess;
+};
+GlareSplit split_for_fft(Image image, const GlareKernel& kernel);
 // `image` with `margin` copies of its edge rows and columns on every side.
 Image extend_edges(const Image& image, int margin);
 // The width x height window of `image` whose top-left pixel is (x0, y0).

@@ -33,6 +33,7 @@ from typing import Any
 import numpy as np
 
 BACKGROUND_ID = -1
+SUBPIXEL_CORE_ID = -2  # pixels near a lamp core smaller than a pixel (not modelled here)
 LAMP_ID_BASE = 1_000_000
 _FACES_PER_SURFACE = 8  # surface id = index * 8 + box face (0..5; 0 for planes and spheres)
 _DEFAULT_LAMP_RADIUS = 0.05
@@ -63,7 +64,8 @@ class ReferenceImage:
 
     def smooth_mask(self) -> np.ndarray:
         """Pixels whose 3x3 neighbourhood has one hit id and one lit state for every
-        light (the 1-pixel image border is excluded)."""
+        light, away from lamp cores smaller than a pixel (the 1-pixel image border is
+        excluded)."""
         h, w = self.hit_id.shape
         keys = [self.hit_id] + [self.lit[i].astype(np.int64) for i in range(self.lit.shape[0])]
         mask = np.zeros((h, w), dtype=bool)
@@ -74,7 +76,7 @@ class ReferenceImage:
                 for dx in (-1, 0, 1):
                     inner &= key[1 + dy:h - 1 + dy, 1 + dx:w - 1 + dx] == centre
         mask[1:-1, 1:-1] = inner
-        return mask
+        return mask & (self.hit_id != SUBPIXEL_CORE_ID)
 
 
 @dataclass
@@ -294,16 +296,16 @@ def render_reference(scene: Any, width: int | None = None, height: int | None = 
     hit_id[sees_lamp] = LAMP_ID_BASE + lamp[sees_lamp]
     # Lamps smaller than a pixel are drawn box-filtered around where their centre
     # projects (shading.glsl, lamp_subpixel_cores), which this reference does not
-    # model: the 5 x 5 pixels there get the lamp's id, so smooth_mask leaves them out.
+    # model: the 5 x 5 pixels there get SUBPIXEL_CORE_ID, which smooth_mask leaves out.
     hit_id = hit_id.reshape(h, w)
     pixel_angle = 2.0 * math.tan(math.radians(sc["camera"]["fov_y"]) / 2.0) / h
-    for j, light in enumerate(lights):
+    for light in lights:
         to_lamp = light.position - origin
         best = int(np.argmax(d @ (to_lamp / np.linalg.norm(to_lamp))))
         if float(d[best] @ to_lamp) < np.linalg.norm(to_lamp) * math.cos(2.0 * pixel_angle):
             continue  # outside the picture
         row, col = divmod(best, w)
-        hit_id[max(row - 2, 0):row + 3, max(col - 2, 0):col + 3] = LAMP_ID_BASE + j
+        hit_id[max(row - 2, 0):row + 3, max(col - 2, 0):col + 3] = SUBPIXEL_CORE_ID
     return ReferenceImage(
         radiance=radiance.reshape(h, w, 3),
         hit_id=hit_id,

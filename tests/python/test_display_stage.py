@@ -279,3 +279,41 @@ def test_glare_shortcuts_never_move_a_value_by_more_than_one_step(case: tuple[np
     reference = airlight.display(spread, exposure=report["exposure"], tonemap=kwargs["tonemap"])
     diff = np.abs(shown.astype(int) - reference.astype(int))
     assert diff.max() <= 1, (report, int(np.count_nonzero(diff > 1)))
+
+
+@pytest.mark.parametrize("fov_y", [10.0, 30.0])
+def test_infinite_pixel_glares_only_within_the_kernel(fov_y: float) -> None:
+    """+inf radiance is shown as 1e30 (white): its glare reaches the kernel's radius and no
+    further (the FFT, whose roundoff is relative to its largest input, never sees it)."""
+    image = np.full((48, 64, 3), [0.8, 0.6, 0.5], np.float32)
+    image[0, 0, 0] = np.inf
+    glare = {"pupil_diameter": 1.0}
+    shown, report = airlight.display_report(image, tonemap="linear", exposure=0.27, glare=glare, fov_y=fov_y)
+    r = report["glare_kernel_radius"]
+    assert r < 40
+    plain = airlight.display(image, tonemap="linear", exposure=0.27)
+    np.testing.assert_array_equal(shown[r + 1:, r + 1:], plain[r + 1:, r + 1:])
+    assert shown[0, 1, 0] == 255  # the glare next to it saturates
+    exact = airlight.glare(image, fov_y=fov_y, pupil_diameter=1.0)
+    assert np.isfinite(exact).all()
+    reference = airlight.display(exact, exposure=0.27, tonemap="linear")
+    assert np.abs(shown.astype(int) - reference.astype(int)).max() <= 1
+
+
+def test_dark_subpixel_lamps_never_make_radiance_negative(renderer) -> None:
+    """A core box-filtered onto pixels farther off-axis than itself weighs slightly more
+    than the pixel's area (the solid-angle ratio): the background it hides must stop at
+    zero, not go negative (a dark lamp over a bright background)."""
+    width, height, fov = 64, 48, 100.0
+    pixel = 2 * math.tan(math.radians(fov) / 2) / height
+    d = 20.0
+    lamps = []
+    for angle in (35.0, 40.0, 45.0):
+        for shift in (0.0, 0.3, 0.5):
+            x = d * math.tan(math.radians(angle)) + shift * pixel * d
+            lamps.append([x, shift * pixel * d, -d])
+    scene = _lamp_scene(lamps, 0.85 * pixel * d, fov, (width, height), intensity=0.0)
+    scene["background"] = [1.0, 1.0, 1.0]
+    image = renderer.render(scene)
+    assert image.min() >= 0.0
+    assert image.min() < 0.5  # the dark cores do hide the background
