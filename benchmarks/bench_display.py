@@ -12,9 +12,9 @@ Each radiance image is rendered once on the CPU; then each backend's display
 stage runs ``--repeats`` times after one warm-up call (which builds the glare
 kernel and, on GL, compiles the programs and caches the kernel's spectrum) and
 the median is printed, with the glare method the run chose ("skipped",
-"sparse", "fft" on the CPU, "gl-fft" on GL), the number of pixels above their
-tile's threshold (whose excess is spread exactly; the GL backend convolves the
-whole image once there is one) and the kernel's radius (``display_report``,
+"sparse": splats on the CPU, on either backend; "fft" on the CPU, "gl-fft" on
+GL), the number of pixels above their tile's threshold (whose excess is
+spread exactly; the FFT convolves the whole image) and the kernel's radius (``display_report``,
 docs/glare.md: what is not spread moves no 8-bit value by more than one
 step). Times are wall-clock on whatever machine runs it (llvmpipe for GL
 without a GPU): compare ratios.

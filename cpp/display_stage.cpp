@@ -408,6 +408,20 @@ GlarePlan plan_glare(const Image& linear, const DisplaySettings& settings, float
     return plan;
 }
 
+bool glare_prefers_sparse(const Image& linear, const GlarePlan& plan) {
+    if (!plan.kernel) return false;
+    // Cost model, in multiply-adds: splatting the sources is 3 (2r + 1)^2 per
+    // source (those in the r-pixel margin of extend_edges included, about
+    // 2 r (w + h) / (w h) more); the FFT path is about 6 complex 2-D
+    // transforms of the padded image, ~ 30 w h log2(w h) real operations.
+    const int size = plan.kernel->size();
+    const double pixels = double(linear.width) * double(linear.height);
+    const double margin = 1.0 + 2.0 * plan.kernel->radius * double(linear.width + linear.height) / pixels;
+    const double splat_cost = double(plan.sources) * margin * 3.0 * double(size) * double(size);
+    const double fft_cost = 30.0 * pixels * std::log2(std::max(pixels, 2.0));
+    return splat_cost < fft_cost;
+}
+
 Image apply_glare_plan(const Image& linear, const GlarePlan& plan, int threads, std::string* method) {
     auto say = [&](const char* m) {
         if (method != nullptr) *method = m;
@@ -418,15 +432,7 @@ Image apply_glare_plan(const Image& linear, const GlarePlan& plan, int threads, 
     }
     const GlareKernel& kernel = *plan.kernel;
     const int r = kernel.radius;
-    // Cost model, in multiply-adds: splatting the sources is 3 (2r + 1)^2 per
-    // source (those in the r-pixel margin of extend_edges included, about
-    // 2 r (w + h) / (w h) more); the FFT path is about 6 complex 2-D
-    // transforms of the padded image, ~ 30 w h log2(w h) real operations.
-    const double pixels = double(linear.width) * double(linear.height);
-    const double margin = 1.0 + 2.0 * r * double(linear.width + linear.height) / pixels;
-    const double splat_cost = double(plan.sources) * margin * 3.0 * double(kernel.size()) * double(kernel.size());
-    const double fft_cost = 30.0 * pixels * std::log2(std::max(pixels, 2.0));
-    if (splat_cost >= fft_cost) {
+    if (!glare_prefers_sparse(linear, plan)) {
         say("fft");
         return glare_exact(linear, kernel, threads);
     }
@@ -484,17 +490,25 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
     report.glare_sources = plan.sources;
     report.glare = settings.glare.enabled ? "skipped" : "off";
     if (gl != nullptr) {
-        // The GPU convolves the whole edge-extended image (glare_exact; the
-        // exact result, not the sparse split) and tone-maps it; the margin is
+        // Few pixels to spread: the CPU splats them (apply_glare_plan) and the
+        // GPU tone-maps. Many: the GPU convolves the whole edge-extended image
+        // (glare_exact's split: the clipped image by FFT, the excess of the
+        // brightest pixels added as splats) and tone-maps it; the margin is
         // cropped from the bytes.
         GlDisplayJob job;
         GlareSplit split;
+        Image splatted;
         int margin = 0;
         job.linear = &linear;
         job.exposure = report.exposure;
         job.curve = tone_curve_shader_id(settings.curve);
         job.white = report.white;
-        if (plan.enabled && plan.sources > 0) {
+        if (plan.enabled && plan.sources > 0 && glare_prefers_sparse(linear, plan)) {
+            std::string method;
+            splatted = apply_glare_plan(linear, plan, threads, &method);
+            job.linear = &splatted;
+            report.glare = method;
+        } else if (plan.enabled && plan.sources > 0) {
             margin = plan.kernel->radius;
             split = split_for_fft(extend_edges(linear, margin), *plan.kernel);
             job.linear = &split.clipped;

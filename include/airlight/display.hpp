@@ -168,11 +168,16 @@ GlarePlan plan_glare(const Image& linear, const DisplaySettings& settings, float
 // "sparse" or "fft".
 Image apply_glare_plan(const Image& linear, const GlarePlan& plan, int threads = 0, std::string* method = nullptr);
 
+// True when splatting the plan's sources costs fewer operations than the
+// exact convolution's FFT (the choice apply_glare_plan makes; the GL backend
+// makes it too, splatting on the CPU and tone-mapping on the GPU).
+bool glare_prefers_sparse(const Image& linear, const GlarePlan& plan);
+
 // What a display run did.
 struct DisplayReport {
     float exposure = 1.0f;
     float white = 1.0f;
-    std::string glare = "off";  // "off", "skipped", "sparse", "fft" (CPU) or "gl-fft"
+    std::string glare = "off";  // "off", "skipped", "sparse" (CPU splats), "fft" (CPU) or "gl-fft"
     double pupil_diameter_mm = 0.0;
     int glare_kernel_radius = 0;
     double glare_threshold = 0.0;    // radiance; see GlarePlan

@@ -325,7 +325,8 @@ def display_report(radiance: np.ndarray, *, exposure: str | float = "auto", tone
                    renderer: Renderer | None = None) -> tuple[np.ndarray, dict[str, Any]]:
     """:func:`display` and what it did: ``exposure`` and ``white`` used,
     ``glare`` (``"off"``, ``"skipped"`` when no pixel is bright enough,
-    ``"sparse"`` or ``"fft"`` on the CPU, ``"gl-fft"`` on GL),
+    ``"sparse"`` (splats on the CPU, on either backend), ``"fft"`` on the
+    CPU, ``"gl-fft"`` on GL),
     ``pupil_diameter`` (mm), ``glare_kernel_radius`` (pixels),
     ``glare_threshold`` (radiance: the excess of each channel over it is
     spread, see ``docs/glare.md``), ``glare_error_bound`` (radiance: no pixel
