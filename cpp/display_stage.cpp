@@ -33,9 +33,9 @@ int resolve_threads(int threads) {
     return int(std::max(1u, std::thread::hardware_concurrency()));
 }
 
-// Glare kernels by (pupil mm, eyelashes, pixel angle): the kernel costs about
-// 0.1 s, an animation reuses it every frame. A few entries are kept (an
-// approaching-car sequence changes the pupil only when asked to).
+// Glare kernels by (pupil mm, eyelashes, pixel angle): a kernel costs about
+// 0.03 s, an animation reuses it every frame (the automatic pupil is rounded
+// to 0.05 mm for that). A few entries are kept.
 std::shared_ptr<const GlareKernel> cached_kernel(double pupil_mm, bool eyelashes, double pixel_angle) {
     using Key = std::tuple<double, bool, double>;
     static std::mutex mutex;
@@ -371,7 +371,10 @@ GlarePlan plan_glare(const Image& linear, const DisplaySettings& settings, float
     } else {
         // Adaptation luminance: the log-average luminance (auto_exposure with key 1 is its inverse).
         const double log_average = 1.0 / double(auto_exposure(linear, 1.0f, threads));
-        plan.pupil_diameter_mm = pupil_diameter_from_luminance(std::max(kLuminousEfficacy * log_average, 1e-30));
+        // Rounded to 0.05 mm (about 1 % of the Airy core's size) so that the frames of an animation share
+        // kernels.
+        const double pupil = pupil_diameter_from_luminance(std::max(kLuminousEfficacy * log_average, 1e-30));
+        plan.pupil_diameter_mm = std::round(pupil * 20.0) / 20.0;
     }
     plan.pixel_angle = camera_pixel_angle(fov_y_degrees, linear.height);
     plan.kernel = cached_kernel(plan.pupil_diameter_mm, settings.glare.eyelashes, plan.pixel_angle);

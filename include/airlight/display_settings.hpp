@@ -26,7 +26,7 @@ struct GlareSettings {
     bool enabled = false;
     // Pupil diameter in mm, in [1, 9]; empty: from the adaptation luminance
     // (pupil_diameter_from_luminance of the image's log-average luminance
-    // times kLuminousEfficacy, see display.hpp).
+    // times kLuminousEfficacy, see display.hpp), rounded to 0.05 mm.
     std::optional<double> pupil_diameter_mm;
     bool eyelashes = false;
 };
