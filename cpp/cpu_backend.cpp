@@ -25,6 +25,13 @@ struct CpuShader {
 
     const float* phase_moment_texels[2];  // per phase lobe (null when unused)
     const float* phase_glow_texels[2];
+    const float* sky_texels;  // RGBA, width SKY_TABLE columns (null when unused)
+    int sky_table_width;
+
+    vec4 sky_table_texel(int x, int y) const {
+        const float* t = sky_texels + (size_t(y) * size_t(sky_table_width) + size_t(x)) * 4;
+        return vec4(t[0], t[1], t[2], t[3]);
+    }
 
     float table_texel(int table, int x, int y) const {
         if (table == TABLE_AIRLIGHT_TAIL) return airlight_tail_texels[y * AIRLIGHT_TAIL_NX + x];
@@ -57,12 +64,17 @@ struct CpuShader {
 #define HAS_SPOT_LIGHTS (features.spot_lights)
 #define HAS_SPOT_AIRLIGHT (features.spot_airlight)
 #define HAS_PHASE (features.phase)
+#define HAS_SKY (features.sky)
+#define HAS_SUN (features.sun)
+#define HAS_ATMOSPHERE (features.atmosphere)
+#define SKY_MARCH (features.sky_march)
 // The same order as the GLSL source (gl_backend.cpp).
 // clang-format off
 #include "geometry.glsl"
 #include "airlight.glsl"
 #include "phase.glsl"
 #include "spot.glsl"
+#include "sky.glsl"
 #include "shading.glsl"
 // clang-format on
 #undef HAS_MEDIUM
@@ -74,6 +86,10 @@ struct CpuShader {
 #undef HAS_SPOT_LIGHTS
 #undef HAS_SPOT_AIRLIGHT
 #undef HAS_PHASE
+#undef HAS_SKY
+#undef HAS_SUN
+#undef HAS_ATMOSPHERE
+#undef SKY_MARCH
 };
 
 }  // namespace shader
@@ -99,7 +115,9 @@ void CpuBackend::render(const FrameData& data, Image& out) {
                                     data.spot_lights.data(),
                                     data.features,
                                     {texels_of(data.phase_moments[0]), texels_of(data.phase_moments[1])},
-                                    {texels_of(data.phase_glow[0]), texels_of(data.phase_glow[1])}};
+                                    {texels_of(data.phase_glow[0]), texels_of(data.phase_glow[1])},
+                                    texels_of(data.sky_table),
+                                    data.sky_table ? data.sky_table->width : 0};
     std::atomic<int> next_row{0};
     auto worker = [&]() {
         shader::CpuShader local = program;

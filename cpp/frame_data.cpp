@@ -6,6 +6,8 @@
 #include <glm/gtx/component_wise.hpp>
 #include <limits>
 
+#include "sky.hpp"
+
 namespace airlight {
 namespace {
 
@@ -84,6 +86,31 @@ std::vector<std::pair<PhaseLobe, float>> phase_lobes(const Phase& phase) {
             break;
     }
     return lobes;
+}
+
+// The daytime part (issue 6; sky.glsl): sky, sun, the atmosphere's species
+// and altitude levels, the feature switches and the sky table if needed.
+void add_daytime(const Scene& scene, FrameData& data) {
+    shader::FrameUniforms& f = data.frame;
+    f.sky = make_sky_gpu(scene.sky, scene.sun);
+    make_species_gpu(scene.atmosphere, f.species);
+    data.features.sky =
+        scene.sky.model != SkyModel::none && glm::any(glm::greaterThan(scene.sky.zenith_radiance, glm::vec3(0.0f)));
+    data.features.sun = f.sky.sun_direction.w != 0.0f;
+    data.features.atmosphere =
+        f.species[0].phase.z != 0.0f || f.species[1].phase.z != 0.0f || f.species[2].phase.z != 0.0f;
+    data.features.sky_march = data.features.atmosphere && scene.quality.airlight == AirlightMethod::march;
+    float top = 0.0f;
+    std::vector<float> levels;
+    if (data.features.atmosphere) levels = make_altitude_levels(f.species, scene.quality.sky_segments, top);
+    for (size_t k = 0; k < levels.size() && k < size_t(shader::ATMOSPHERE_MAX_LEVELS); ++k)
+        f.altitude_levels[k / 4][int(k % 4)] = levels[k];
+    const bool columns = data.features.sky && data.features.atmosphere;
+    if (columns || (data.features.sky && data.features.surfaces))
+        data.sky_table = &sky_phase_table(f.sky, f.species, columns);
+    f.atmosphere = glm::vec4(top, float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS))),
+                             data.sky_table ? float(data.sky_table->width) : 1.0f,
+                             data.sky_table ? float(data.sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f);
 }
 
 }  // namespace
@@ -231,6 +258,7 @@ FrameData make_frame_data(const Scene& scene) {
         if (point_glow) data.surface_glow = &surface_glow_table();
         if (point_tail) data.airlight_tail = &airlight_tail_table();
     }
+    add_daytime(scene, data);
     return data;
 }
 

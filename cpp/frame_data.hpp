@@ -24,6 +24,10 @@ struct FrameData {
     // Per phase lobe (anisotropic media; docs/phase_table.md).
     const Table2D* phase_moments[2] = {nullptr, nullptr};
     const Table2D* phase_glow[2] = {nullptr, nullptr};
+    // The sky-phase table (sky.glsl; cpp/sky.hpp): only for a sky that lights
+    // an atmosphere (then with its columns) or surfaces (C = 0 only when
+    // there is no atmosphere).
+    const Table2D* sky_table = nullptr;
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and

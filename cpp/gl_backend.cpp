@@ -258,8 +258,13 @@ std::string fragment_shader_source(const shader::Features& features) {
     source += std::string("#define HAS_SPOT_LIGHTS ") + (features.spot_lights ? "true" : "false") + "\n";
     source += std::string("#define HAS_SPOT_AIRLIGHT ") + (features.spot_airlight ? "true" : "false") + "\n";
     source += std::string("#define HAS_PHASE ") + (features.phase ? "true" : "false") + "\n";
-    for (const char* name : {"constants.glsl", "layout.glsl", "phase_math.glsl", "resources.glsl", "geometry.glsl",
-                             "airlight.glsl", "phase.glsl", "spot.glsl", "shading.glsl", "render.frag"}) {
+    source += std::string("#define HAS_SKY ") + (features.sky ? "true" : "false") + "\n";
+    source += std::string("#define HAS_SUN ") + (features.sun ? "true" : "false") + "\n";
+    source += std::string("#define HAS_ATMOSPHERE ") + (features.atmosphere ? "true" : "false") + "\n";
+    source += std::string("#define SKY_MARCH ") + (features.sky_march ? "true" : "false") + "\n";
+    for (const char* name :
+         {"constants.glsl", "layout.glsl", "phase_math.glsl", "sky_math.glsl", "resources.glsl", "geometry.glsl",
+          "airlight.glsl", "phase.glsl", "spot.glsl", "sky.glsl", "shading.glsl", "render.frag"}) {
         source += "// ---- " + std::string(name) + "\n";
         source += shader_source(name);
     }
@@ -273,12 +278,17 @@ struct GlBackend::State {
     GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0, bvh_ssbo = 0, spot_ssbo = 0;
     size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0, bvh_capacity = 0, spot_capacity = 0;
     int fbo_width = 0, fbo_height = 0;
-    std::map<const Table2D*, GLuint> table_textures;  // uploaded once per context
+    std::map<const Table2D*, std::pair<long, GLuint>> table_textures;  // by address: (serial, texture)
 
-    // The texture holding `table`, uploaded on first use.
+    // The texture holding `table`, uploaded on first use (again when a cache
+    // reused the address for another table: the serial differs).
     GLuint texture_for(const Table2D& table) {
         auto it = table_textures.find(&table);
-        if (it != table_textures.end()) return it->second;
+        if (it != table_textures.end()) {
+            if (it->second.first == table.serial) return it->second.second;
+            glDeleteTextures(1, &it->second.second);
+            table_textures.erase(it);
+        }
         GLuint tex = 0;
         glCreateTextures(GL_TEXTURE_2D, 1, &tex);
         glTextureStorage2D(tex, 1, table.channels == 4 ? GL_RGBA32F : GL_R32F, table.width, table.height);
@@ -286,7 +296,7 @@ struct GlBackend::State {
         glTextureParameteri(tex, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
         glTextureSubImage2D(tex, 0, 0, 0, table.width, table.height, table.channels == 4 ? GL_RGBA : GL_RED, GL_FLOAT,
                             table.texels.data());
-        table_textures[&table] = tex;
+        table_textures[&table] = {table.serial, tex};
         return tex;
     }
 
@@ -635,7 +645,7 @@ GlBackend::~GlBackend() {
     if (state_->egl.context != EGL_NO_CONTEXT) {
         state_->make_current();
         for (auto& entry : state_->programs) glDeleteProgram(entry.second);
-        for (auto& entry : state_->table_textures) glDeleteTextures(1, &entry.second);
+        for (auto& entry : state_->table_textures) glDeleteTextures(1, &entry.second.second);
         glDeleteTextures(1, &state_->color);
         if (state_->display_program != 0) glDeleteProgram(state_->display_program);
         for (auto& entry : state_->fft_programs) glDeleteProgram(entry.second);
@@ -692,6 +702,7 @@ void GlBackend::render(const FrameData& data, Image& out) {
         if (data.phase_moments[lobe]) glBindTextureUnit(3 + lobe, s.texture_for(*data.phase_moments[lobe]));
         if (data.phase_glow[lobe]) glBindTextureUnit(5 + lobe, s.texture_for(*data.phase_glow[lobe]));
     }
+    if (data.sky_table) glBindTextureUnit(7, s.texture_for(*data.sky_table));
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glDisable(GL_DEPTH_TEST);

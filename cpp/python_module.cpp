@@ -248,11 +248,11 @@ PYBIND11_MODULE(_core, m) {
         py::dict out;
         for (const airlight::TableInfo& info : airlight::tables_built()) {
             py::dict d;
-            d["width"] = info.table->width;
-            d["height"] = info.table->height;
-            d["bytes"] = info.table->texels.size() * sizeof(float);
-            d["build_seconds"] = info.table->build_seconds;
-            out[info.name] = d;
+            d["width"] = info.width;
+            d["height"] = info.height;
+            d["bytes"] = info.bytes;
+            d["build_seconds"] = info.build_seconds;
+            out[info.name.c_str()] = d;
         }
         return out;
     });

@@ -19,6 +19,7 @@ using namespace glm;
 #include "constants.glsl"
 #include "layout.glsl"
 #include "phase_math.glsl"
+#include "sky_math.glsl"
 
 // The display stage's per-pixel math (issue 8): independent of the above.
 #include "display.glsl"
@@ -35,11 +36,16 @@ struct Features {
     bool spot_lights = false;     // spotlights: direct light and cores
     bool spot_airlight = false;   // spotlights in a scattering medium
     bool phase = false;           // an anisotropic phase function (phase.glsl); else isotropic
+    bool sky = false;             // a sky dome (sky.glsl): seen by escaping rays, lights surfaces
+    bool sun = false;             // a sun above the horizon with some irradiance
+    bool atmosphere = false;      // a height-varying atmosphere: scattering volumes along view rays
+    bool sky_march = false;       // brute-force marching of the atmosphere instead (benchmarks)
 
     int key() const {
         return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |
                (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0) | (spot_lights ? 64 : 0) | (spot_airlight ? 128 : 0) |
-               (phase ? 256 : 0);
+               (phase ? 256 : 0) | (sky ? 512 : 0) | (sun ? 1024 : 0) | (atmosphere ? 2048 : 0) |
+               (sky_march ? 4096 : 0);
     }
 };
 

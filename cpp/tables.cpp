@@ -72,12 +72,6 @@ Table2D timed_build(const char* name, Build build) {
     return table;
 }
 
-bool register_table(const Table2D& table) {
-    std::lock_guard<std::mutex> lock(registry_mutex);
-    registry().push_back({table.name, &table});
-    return true;
-}
-
 // Quadrature nodes in g in [0, pi] for the glow integral: panels graded
 // geometrically towards g = 0, where Q(T sin g, g/2) has a boundary layer of
 // width ~1/T, then uniform. Returns (g, weight) pairs.
@@ -108,6 +102,13 @@ std::vector<std::pair<double, double>> glow_nodes(int scale, std::vector<double>
 }
 
 }  // namespace
+
+bool register_table(const Table2D& table) {
+    std::lock_guard<std::mutex> lock(registry_mutex);
+    registry().push_back(
+        {table.name, table.width, table.height, table.texels.size() * sizeof(float), table.build_seconds});
+    return true;
+}
 
 double surface_glow_cos_theta(double Y, double optical_distance, double k_min) {
     // K = max(T, k_min) as the shader forms it in float32

@@ -3,6 +3,7 @@
 // parametrisations, resolutions and measured errors: docs/airlight_table.md.
 #pragma once
 
+#include <string>
 #include <vector>
 
 #include "shader_cpp.hpp"
@@ -18,6 +19,7 @@ struct Table2D {
     int channels = 1;  // texels per grid node (1: R32F, 4: RGBA32F)
     std::vector<float> texels;
     double build_seconds = 0.0;
+    long serial = 0;  // distinguishes tables that a cache built at the same address (GL texture cache)
 };
 
 // Exact normalised airlight tail (MODELS.md section 1, docs/airlight_table.md)
@@ -80,9 +82,14 @@ double phase_airlight_bound(const PhaseLobe& lobe);
 // The tables built so far in this process, by name (for tests showing that a
 // scene which does not need a table builds none, and for reporting memory).
 struct TableInfo {
-    const char* name;
-    const Table2D* table;
+    std::string name;
+    int width = 0;
+    int height = 0;
+    size_t bytes = 0;
+    double build_seconds = 0.0;
 };
 std::vector<TableInfo> tables_built();
+// Records a table in that list (tables built outside cpp/tables.cpp: the sky table).
+bool register_table(const Table2D& table);
 
 }  // namespace airlight

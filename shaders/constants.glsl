@@ -52,3 +52,24 @@ CONST int TABLE_PHASE_GLOW_1 = 6;
 // |g| is clamped here for rendering: past it the tables' error grows
 // (1.6e-3 at 0.9999, 6.4e-3 at -0.999; docs/phase_table.md section 0).
 CONST float PHASE_G_LIMIT = 0.999f;
+
+// ---- Daytime sky and atmosphere (MODELS.md section 3; docs/daytime.md) ----
+CONST int SKY_NONE = 0;
+CONST int SKY_OVERCAST = 1;
+CONST int SKY_CIE = 2;
+// The altitude levels that split view rays into scattering volumes: the
+// quality knob's levels plus the profiles' breaks, the ground and the top.
+CONST int ATMOSPHERE_MAX_LEVELS = 80;
+// Sky-phase table (cpp/sky_table.cpp, sky.glsl): per kernel k (RGB: the three
+// species' phase functions, A: the clamped cosine of irradiance)
+//   F_k(C, d) = int_{w_y > 0} shape(w) exp(-C / w_y) k(d . w) dw,
+// stored as log(F e^C + SKY_TABLE_FLOOR) on a node-aligned grid:
+//   X = sqrt(log(1 + C / C0) / log(1 + C_MAX / C0))   (NC columns),
+//   elevation of d uniform in [-pi/2, pi/2]            (N_ELEVATION rows),
+//   azimuth of d from the sun's, uniform in [0, pi]    (N_AZIMUTH blocks of rows; 1 for skies without a sun).
+CONST int SKY_TABLE_NC = 64;
+CONST int SKY_TABLE_N_ELEVATION = 64;
+CONST int SKY_TABLE_N_AZIMUTH = 32;
+CONST float SKY_TABLE_C0 = 0.01f;
+CONST float SKY_TABLE_C_MAX = 100.0f;
+CONST float SKY_TABLE_FLOOR = 1.0e-12f;

@@ -8,6 +8,28 @@ struct PhaseLobeGpu {
     vec4 info;   // x: g, y: 1 for Rayleigh, z: glow row-warp floor K_min, w: weight in the mixture
 };
 
+// The sky dome and the sun (MODELS.md section 3; sky.glsl).
+struct SkyGpu {
+    vec4 zenith_radiance;  // rgb: Lz; w: model (SKY_NONE, SKY_OVERCAST, SKY_CIE)
+    vec4 gradation;        // x: a, y: b, z: 1 / (phi(0) f(Z_s)) (CIE normaliser)
+    vec4 indicatrix;       // x: c, y: d, z: e, w: exp(d pi / 2)
+    vec4 sun_direction;    // xyz: unit vector toward the sun; w: 1 when the sun lights the scene (above the horizon)
+    vec4 sun_irradiance;   // rgb: irradiance on a plane facing the sun at the top of the atmosphere (W/m^2)
+};
+
+// One particle species of the atmosphere (sky.glsl): extinction and
+// scattering at relative density 1 times a piecewise exponential relative
+// density rho(y) = value_k exp(-(y - start_k) inv_scale_k) on [start_k,
+// start_{k+1}) (4 pieces; unused pieces start at NO_HIT).
+struct SpeciesGpu {
+    vec4 sigma_t;      // rgb: extinction (1/m) at rho = 1
+    vec4 sigma_s;      // rgb: scattering (1/m) at rho = 1
+    vec4 phase;        // x: HG g, y: 1 for Rayleigh, z: 1 when present
+    vec4 starts;       // altitudes where the pieces start (x = 0)
+    vec4 values;       // rho at each piece's start
+    vec4 inv_scales;   // 1 / scale height of each piece (0: constant, < 0: growing)
+};
+
 // Per-frame constants (std140 uniform block on the GPU).
 struct FrameUniforms {
     vec4 camera_position;  // xyz: pinhole position
@@ -25,6 +47,10 @@ struct FrameUniforms {
     vec4 phase_bounds;     // x: int_0^{pi/2} P dt (airlight culling; pi/2 isotropic), y: max G (glow culling)
     PhaseLobeGpu phase_lobe0;
     PhaseLobeGpu phase_lobe1;
+    SkyGpu sky;
+    SpeciesGpu species[3];  // molecules, aerosol, rain (phase.z = 0 when absent)
+    vec4 atmosphere;        // x: top altitude (empty above), y: altitude levels, z: sky table columns (1: C = 0 only), w: its azimuth blocks
+    vec4 altitude_levels[ATMOSPHERE_MAX_LEVELS / 4];  // sorted level altitudes, 4 per vec4 (sky.glsl)
 };
 
 // An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting

@@ -23,6 +23,11 @@ layout(binding = 3) uniform sampler2D phase_moment_texels0;  // per phase lobe (
 layout(binding = 4) uniform sampler2D phase_moment_texels1;
 layout(binding = 5) uniform sampler2D phase_glow_texels0;
 layout(binding = 6) uniform sampler2D phase_glow_texels1;
+layout(binding = 7) uniform sampler2D sky_texels;  // the sky-phase table (sky.glsl)
+
+vec4 sky_table_texel(int x, int y) {
+    return texelFetch(sky_texels, ivec2(x, y), 0);
+}
 
 float table_texel(int table, int x, int y) {
     if (table == TABLE_AIRLIGHT_TAIL) return texelFetch(airlight_tail_texels, ivec2(x, y), 0).r;

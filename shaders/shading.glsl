@@ -298,13 +298,33 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         bool black = albedo.x == 0.0f && albedo.y == 0.0f && albedo.z == 0.0f;
         if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal);
         if (HAS_SPOT_LIGHTS && !black) irradiance += spot_light_irradiance(p, normal, irradiance);
+        if (HAS_SKY && !black) irradiance += sky_irradiance(p, normal);
+        if (HAS_SUN && !black && dot(normal, vec3(frame.sky.sun_direction)) > 0.0f &&
+            !(HAS_SURFACES && segment_occluded(p + surface_offset(p) * normal, vec3(frame.sky.sun_direction), NO_HIT))) {
+            irradiance += sun_irradiance(p, normal);
+        }
         radiance = albedo / PI * irradiance;
     } else {
         radiance = vec3(frame.background);
+        if (HAS_SKY) radiance += sky_radiance(dir);
     }
     // Everything behind the medium reaches the camera attenuated; the fog in
     // front of it adds its glow.
     radiance *= transmittance(t_hit);
+    // The atmosphere (daytime, sky.glsl): aerial perspective on whatever the
+    // ray ends at, plus the sky and sun light its particles scatter.
+    if (HAS_ATMOSPHERE) {
+        vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
+        vec3 inscatter;
+        vec3 atmosphere_transmittance;
+        if (SKY_MARCH) {
+            atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.quality.y), inscatter,
+                                        atmosphere_transmittance);
+        } else {
+            atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, atmosphere_transmittance);
+        }
+        radiance = radiance * atmosphere_transmittance + inscatter;
+    }
     if (HAS_AIRLIGHT) {
         for (int i = 0; i < point_light_count(); ++i) {
             radiance += point_light_airlight(point_light(i), origin, dir, t_hit, radiance);

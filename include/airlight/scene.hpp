@@ -95,6 +95,75 @@ struct Surface {
     Rgb albedo{0.5f};
 };
 
+// ---- Daytime: sky dome, sun and a height-varying atmosphere (MODELS.md
+// section 3; issue 6; docs/daytime.md). Altitude is y in metres above the
+// ground plane y = 0; the atmosphere exists for y >= 0.
+
+enum class SkyModel {
+    none,      // no sky: escaping rays see `background` only
+    overcast,  // the classic CIE standard overcast sky L = Lz (1 + 2 cos Z) / 3
+    cie,       // the CIE general sky, ISO 15469 type 1..15 (needs a sun position for types with an indicatrix)
+};
+
+// The sky dome: the radiance entering the atmosphere at its top, L(w) =
+// zenith_radiance x shape(w) for directions above the horizon, 0 below.
+struct Sky {
+    SkyModel model = SkyModel::none;
+    int cie_type = 1;  // 1..15, for SkyModel::cie
+    Rgb zenith_radiance{0.0f};
+};
+
+// A directional sun: `direction` is the unit vector toward the sun (scene
+// keys elevation/azimuth in degrees give (sin az cos el, sin el, -cos az cos el)),
+// `irradiance` the irradiance on a plane facing it at the top of the
+// atmosphere (W/m^2 per channel). Below the horizon it lights nothing; it
+// still sets the CIE sky's sun position.
+struct Sun {
+    bool present = false;
+    glm::vec3 direction{0.0f, 1.0f, 0.0f};
+    Rgb irradiance{0.0f};
+};
+
+// Air molecules: Rayleigh scattering, sea-level coefficients times
+// density_scale, scale height 8 km (MODELS.md section 3).
+struct Molecules {
+    bool present = false;
+    float density_scale = 1.0f;
+};
+
+// Aerosol (haze, fog): Henyey-Greenstein g, single-scattering albedo, grey
+// extinction at the ground given either by the visibility (Koschmieder,
+// 3.912 / V for the clear air, molecules included) or directly by the
+// coefficient; exponential decay with scale_height up to the minimum at
+// 2250 m, a 25 % rise to 3250 m, decay above (MODELS.md section 3).
+struct Aerosol {
+    bool present = false;
+    float visibility = 0.0f;   // m; > 0 when given
+    float coefficient = 0.0f;  // 1/m at the ground; used when visibility == 0
+    float scale_height = 1000.0f;
+    float g = 0.7f;
+    float albedo = 0.9f;
+};
+
+// Raindrops: Marshall-Palmer drop sizes for the rainfall rate (mm/h), whose
+// extinction is pi N0 / Lambda^3 (extinction efficiency 2) times
+// density_scale; constant density from the ground to `top` (the cloud base,
+// m); Henyey-Greenstein g of large drops.
+struct Rain {
+    bool present = false;
+    float rate = 0.0f;
+    float density_scale = 1.0f;
+    float top = 1500.0f;
+    float g = 0.87f;
+};
+
+struct Atmosphere {
+    Molecules molecules;
+    Aerosol aerosol;
+    Rain rain;
+    bool any() const { return molecules.present || aerosol.present || rain.present; }
+};
+
 // How the airlight is computed (MODELS.md section 1).
 enum class AirlightMethod {
     analytic,  // the table method: exact up to the tables' measured error
@@ -113,6 +182,10 @@ struct Quality {
     // beam that gives the light it scatters onto surfaces (a multiple of 4 in
     // [4, 64]; docs/spot_table.md section 9 measures its error).
     int spot_glow_samples = 12;
+    // Accuracy knob of the daytime scattering volumes (MODELS.md section 3):
+    // the number of altitude levels that split view rays through the
+    // atmosphere (docs/daytime.md measures error against it), in [2, 64].
+    int sky_segments = 16;
 };
 
 struct Scene {
@@ -123,7 +196,10 @@ struct Scene {
     std::vector<PointLight> point_lights;
     std::vector<SpotLight> spot_lights;
     std::vector<Surface> surfaces;
-    Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium)
+    Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium), added to the sky's
+    Sky sky;
+    Sun sun;
+    Atmosphere atmosphere;
     Quality quality;
     // How the demo and Renderer::display turn the radiance into an image
     // (issue 8); render() itself always returns linear radiance.
