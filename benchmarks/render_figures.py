@@ -12,7 +12,11 @@
   display stage with automatic exposure, the double-logarithmic curve and the
   glare of a 4 mm pupil with eyelashes, by the demo;
 - approaching_car.png: the headlight experiment (airlight-demo --sequence
-  approaching-car), the middle of 9 frames from 2 km to 20 m side by side.
+  approaching-car), the middle of 9 frames from 2 km to 20 m side by side;
+- day_weather.png: the source paper's figure 5 (issue 6): a town with a road,
+  fields and buildings on a clear day, in heavy rain and in light rain
+  (scenes/day_*.json, each saved by the demo with its own display settings:
+  automatic exposure, filmic curve), side by side.
 
 The first figures use the linear curve (``--tonemap linear``) with the
 exposures above, as before the display stage existed.
@@ -62,6 +66,18 @@ def approaching_car_strip(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 
+def day_weather_strip(backend: str, out: Path) -> None:
+    """The three daytime presets (clear, heavy rain, light rain), side by side."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tiles = []
+        for name in ("day_clear", "day_heavy_rain", "day_light_rain"):
+            demo(name, Path(tmp) / f"{name}.png", backend)
+            with Image.open(Path(tmp) / f"{name}.png") as png:
+                tiles.append(np.asarray(png.convert("RGB")))
+            tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
+    Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
@@ -74,6 +90,7 @@ def main() -> None:
     demo("foggy_street", IMAGES / "foggy_street_eye.png", args.backend, "--exposure", "auto", "--tonemap",
          "loglog", "--glare", "--pupil", "4", "--eyelashes")
     approaching_car_strip(args.backend, IMAGES / "approaching_car.png")
+    day_weather_strip(args.backend, IMAGES / "day_weather.png")
     with airlight.Renderer(args.backend) as r:
         tiles = []
         for density in ("000", "001", "002", "004"):
@@ -84,7 +101,7 @@ def main() -> None:
         crane = r.render(airlight.preset("crane_searchlight"))
         airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
     print(f"wrote {IMAGES}/foggy_street.png, foggy_street_hg.png, spotlights_crossing.png, "
-          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png")
+          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png, day_weather.png")
 
 
 if __name__ == "__main__":

@@ -1,6 +1,7 @@
 // airlight._core: the pybind11 bridge. Scenes arrive as Python objects and are
 // converted to JSON values in C++ so that NaN/Inf survive to the validator;
 // scene errors become TypeError/ValueError naming the field.
+#include <map>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
@@ -246,8 +247,10 @@ PYBIND11_MODULE(_core, m) {
 
     m.def("tables_built", []() {
         py::dict out;
+        std::map<std::string, int> builds;  // tables rebuilt for new parameters (the sky table) count each build
         for (const airlight::TableInfo& info : airlight::tables_built()) {
             py::dict d;
+            d["builds"] = ++builds[info.name];
             d["width"] = info.width;
             d["height"] = info.height;
             d["bytes"] = info.bytes;

@@ -220,7 +220,8 @@ vec3 lamp_subpixel_cores(int x, int row, vec3 radiance) {
             if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
             // The weight can exceed 1 by the solid-angle ratio: the core's part stays exact, the
             // hidden background's never goes negative.
-            radiance = radiance * max(1.0f - cover, 0.0f) + vec3(lamp.intensity) / (PI * r * r) * transmittance(d) * cover;
+            vec3 core = vec3(lamp.intensity) / (PI * r * r) * transmittance(d) * atmosphere_transmittance(origin, rel / d, d);
+            radiance = radiance * max(1.0f - cover, 0.0f) + core * cover;
         }
     }
     if (HAS_SPOT_LIGHTS) {
@@ -235,7 +236,8 @@ vec3 lamp_subpixel_cores(int x, int row, vec3 radiance) {
             vec3 n;
             if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) continue;
             vec3 core = vec3(s.intensity_edge) * (spot_profile_toward(s, -rel / d) / (PI * r * r));
-            radiance = radiance * max(1.0f - cover, 0.0f) + core * transmittance(d) * cover;
+            core *= transmittance(d) * atmosphere_transmittance(origin, rel / d, d);
+            radiance = radiance * max(1.0f - cover, 0.0f) + core * cover;
         }
     }
     return radiance;
@@ -316,14 +318,14 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     if (HAS_ATMOSPHERE) {
         vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
         vec3 inscatter;
-        vec3 atmosphere_transmittance;
+        vec3 through_atmosphere;
         if (SKY_MARCH) {
             atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.quality.y), inscatter,
-                                        atmosphere_transmittance);
+                                        through_atmosphere);
         } else {
-            atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, atmosphere_transmittance);
+            atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, through_atmosphere);
         }
-        radiance = radiance * atmosphere_transmittance + inscatter;
+        radiance = radiance * through_atmosphere + inscatter;
     }
     if (HAS_AIRLIGHT) {
         for (int i = 0; i < point_light_count(); ++i) {

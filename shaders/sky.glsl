@@ -226,6 +226,23 @@ int next_altitude_level(float y, float mu) {
     return -1;
 }
 
+// The end (distance s_b, altitude y_b) of the scattering volume that starts
+// at altitude y_a on the ray o + s d (d_y = mu) inside [s_in, s_out]: the next
+// altitude level, or s_out.
+void volume_end(vec3 o, float mu, float s_in, float s_out, float y_a, OUT(float) s_b, OUT(float) y_b) {
+    int k = next_altitude_level(y_a, mu);
+    s_b = s_out;
+    y_b = y_a;
+    if (k >= 0) {
+        float s_level = s_in + (altitude_level(k) - o.y - mu * s_in) / mu;
+        if (s_level < s_out) {
+            s_b = s_level;
+            y_b = altitude_level(k);
+        }
+    }
+    if (s_b == s_out && mu != 0.0f) y_b = clamp(o.y + mu * s_out, 0.0f, frame.atmosphere.x);
+}
+
 // int_0^dtau e^{-t} S(t) dt for a source S that varies exponentially in
 // optical depth from s_a to s_b (exact when the light reaching the volume is
 // attenuated along one direction, nearly so for the dome): with r = ln(s_b /
@@ -291,17 +308,9 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     vec3 weight = exp(-sigma_medium * s_in);  // transmittance from the camera to s_a, medium included
     SpeciesLight light_a = species_light(t, atmosphere_column(y_a), sun_phase);
     for (int step = 0; step < ATMOSPHERE_MAX_LEVELS + 2 && s_a < s_out; ++step) {
-        int k = next_altitude_level(y_a, mu);
-        float s_b = s_out;
-        float y_b = y_a;
-        if (k >= 0) {
-            float s_level = s_in + (altitude_level(k) - o.y - mu * s_in) / mu;
-            if (s_level < s_out) {
-                s_b = s_level;
-                y_b = altitude_level(k);
-            }
-        }
-        if (s_b == s_out && mu != 0.0f) y_b = clamp(o.y + mu * s_out, 0.0f, frame.atmosphere.x);
+        float s_b;
+        float y_b;
+        volume_end(o, mu, s_in, s_out, y_a, s_b, y_b);
         float len = s_b - s_a;
         float y_piece = 0.5f * (y_a + y_b);
         vec3 tau = stretch_optical_depth(y_a, y_piece, mu, len);
@@ -334,10 +343,44 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     }
 }
 
+// The atmosphere's transmittance along o + s d over [0, s_end] (1 without
+// an atmosphere): lamp cores smaller than a pixel (shading.glsl).
+vec3 atmosphere_transmittance(vec3 o, vec3 d, float s_end) {
+    if (!HAS_ATMOSPHERE) return vec3(1.0f);
+    vec3 inscatter;
+    vec3 t;
+    atmosphere_scattering(o, d, s_end, vec3(0.0f), inscatter, t);
+    return t;
+}
+
+// Where marching stops: s_out, or sooner where the optical depth from the
+// camera of the thinnest channel passes 30 (e^{-30}: nothing further shows),
+// found volume by volume (linear in optical depth inside the last one).
+float march_far_distance(vec3 o, vec3 d, float s_in, float s_out, vec3 sigma_medium) {
+    float mu = d.y;
+    float y_a = o.y + mu * s_in;
+    if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.x);
+    float s_a = s_in;
+    vec3 tau = sigma_medium * s_in;
+    for (int step = 0; step < ATMOSPHERE_MAX_LEVELS + 2 && s_a < s_out; ++step) {
+        float s_b;
+        float y_b;
+        volume_end(o, mu, s_in, s_out, y_a, s_b, y_b);
+        float len = s_b - s_a;
+        vec3 dtau = stretch_optical_depth(y_a, 0.5f * (y_a + y_b), mu, len) + sigma_medium * min(len, 1.0e30f);
+        float before = min(min(tau.x, tau.y), tau.z);
+        tau += dtau;
+        float after = min(min(tau.x, tau.y), tau.z);
+        if (after > 30.0f) return s_a + min(len, 1.0e30f) * (30.0f - before) / (after - before);
+        s_a = s_b;
+        y_a = y_b;
+    }
+    return s_out;
+}
+
 // The same by brute force (benchmarks, SKY_MARCH): `steps` midpoint steps of
-// equal length over [s_in, s_far], where s_far cuts rays that never leave
-// the atmosphere (horizontal ones) where the optical depth of the thinnest
-// channel passes 30; transmittance accumulated step by step.
+// equal length over [s_in, s_far] (march_far_distance: rays end where they
+// have become opaque); transmittance accumulated step by step.
 void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium, int steps,
                                  OUT(vec3) inscatter, OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
@@ -345,21 +388,7 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     float s_in;
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
-    float s_far = s_out;
-    if (s_far >= NO_HIT) {
-        // horizontal: constant altitude, constant density
-        vec3 sigma;
-        vec3 unused_j;
-        SpeciesLight none;
-        none.light[0] = vec3(0.0f);
-        none.light[1] = vec3(0.0f);
-        none.light[2] = vec3(0.0f);
-        atmosphere_point(o.y, o.y, none, sigma, unused_j);
-        sigma += sigma_medium;
-        float thinnest = min(min(sigma.x, sigma.y), sigma.z);
-        if (thinnest <= 0.0f) return;
-        s_far = s_in + 30.0f / thinnest;
-    }
+    float s_far = march_far_distance(o, d, s_in, s_out, sigma_medium);
     SkyTableDirection t = sky_table_direction(d);
     vec3 sun_phase = vec3(0.0f);
     if (HAS_SUN) {

@@ -414,8 +414,11 @@ def load_pfm(path: str | os.PathLike[str]) -> np.ndarray:
 
 def table_stats() -> dict[str, dict[str, Any]]:
     """The scattering tables built so far in this process (each is built once, on
-    first need): name -> width, height, bytes, build_seconds. Empty until a scene
-    with lamps in a scattering medium is rendered."""
+    first need): name -> width, height, bytes, build_seconds, builds. Empty until a
+    scene with lamps in a scattering medium or a sky over an atmosphere or surfaces is
+    rendered. The sky table ("sky_phase", docs/daytime.md) is rebuilt when the sky or
+    the species' phase functions change: ``builds`` counts its builds, the other
+    fields describe the last one."""
     return dict(_core.tables_built())
 
 

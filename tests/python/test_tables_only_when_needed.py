@@ -114,3 +114,36 @@ def test_two_lobes_rayleigh_and_g0_tables():
         ["phase_moments rayleigh"]]
     assert run([base(lights=LAMP, medium=fog_with({"type": "hg", "g": 0.0}))])["seen"] == [
         ["airlight_tail", "surface_glow"]]
+
+
+# ---- Daytime (issue 6): the sky-phase table -------------------------------------------------
+OVERCAST = {"model": "overcast", "zenith_radiance": [1, 1, 1]}
+HAZE = {"molecules": {}, "aerosol": {"visibility": 5000}}
+
+
+def test_sky_table_only_where_a_sky_lights_an_atmosphere_or_surfaces():
+    """No atmosphere and no surfaces: sky pixels come from the formula, no table; an atmosphere
+    lit only by the sun: no table; surfaces under a sky without an atmosphere: a one-column table
+    (C = 0); a sky over an atmosphere: the full table."""
+    sun = {"elevation": 30, "azimuth": 0, "irradiance": [5, 5, 5]}
+    assert run([base(sky=OVERCAST, surfaces=[])])["seen"] == [[]]
+    assert run([base(sun=sun, atmosphere=HAZE)])["seen"] == [[]]
+    assert run([base(atmosphere=HAZE)])["seen"] == [[]]
+    result = run([base(sky=OVERCAST)])
+    assert result["seen"] == [["sky_phase"]]
+    assert result["stats"]["sky_phase"]["width"] == 1
+    result = run([base(sky=OVERCAST, atmosphere=HAZE)])
+    assert result["seen"] == [["sky_phase"]]
+    assert result["stats"]["sky_phase"]["bytes"] == 64 * 64 * 4 * 4  # C x elevation, RGBA, no azimuth
+
+
+def test_sky_table_is_rebuilt_only_when_the_sky_or_the_phases_change():
+    """The table depends on the sky's shape and the species' phase functions, not on densities:
+    a fading rain re-uses it; a sun sky (with azimuth blocks) or another aerosol g builds anew."""
+    rain = [base(sky=OVERCAST, atmosphere={**HAZE, "rain": {"rate": r}}) for r in (50, 10, 1)]
+    clear = base(sky={"model": "cie", "type": 12, "zenith_radiance": [1, 1, 1]},
+                 sun={"elevation": 30, "azimuth": 0, "irradiance": [5, 5, 5]}, atmosphere=HAZE)
+    other_g = base(sky=OVERCAST, atmosphere={"molecules": {}, "aerosol": {"visibility": 5000, "g": 0.5}})
+    result = run(rain + [clear, other_g, rain[0]])
+    assert result["stats"]["sky_phase"]["builds"] == 3  # the rains (also the last frame): one; clear; other g
+    assert result["stats"]["sky_phase"]["height"] == 64  # the last built: azimuth-free
