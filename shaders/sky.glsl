@@ -137,9 +137,11 @@ vec3 sun_irradiance(vec3 p, vec3 n) {
 // The light each species scatters toward the camera per unit scattering
 // coefficient at an altitude whose column is C (MODELS.md section 3, with
 // the exact sky-phase integral in place of the seed's effective phase
-// value): Lz F_i(C, d) + E_sun exp(-C / s_y) p_i(d . s), per channel.
+// value): Lz F_i(C, d) (sky) + E_sun exp(-C / s_y) p_i(d . s) (sun), per
+// channel; kept apart because they change with C at different rates.
 struct SpeciesLight {
-    vec3 light[3];
+    vec3 sky[3];
+    vec3 sun[3];
 };
 
 SpeciesLight species_light(SkyTableDirection t, vec3 column, vec3 sun_phase) {
@@ -155,9 +157,12 @@ SpeciesLight species_light(SkyTableDirection t, vec3 column, vec3 sun_phase) {
     vec3 lz = vec3(frame.sky.zenith_radiance);
     vec3 sun = vec3(0.0f);
     if (HAS_SUN) sun = vec3(frame.sky.sun_irradiance) * exp(-column / frame.sky.sun_direction.y);
-    out_light.light[0] = lz * vec3(k0.x, k1.x, k2.x) + sun * sun_phase.x;
-    out_light.light[1] = lz * vec3(k0.y, k1.y, k2.y) + sun * sun_phase.y;
-    out_light.light[2] = lz * vec3(k0.z, k1.z, k2.z) + sun * sun_phase.z;
+    out_light.sky[0] = lz * vec3(k0.x, k1.x, k2.x);
+    out_light.sky[1] = lz * vec3(k0.y, k1.y, k2.y);
+    out_light.sky[2] = lz * vec3(k0.z, k1.z, k2.z);
+    out_light.sun[0] = sun * sun_phase.x;
+    out_light.sun[1] = sun * sun_phase.y;
+    out_light.sun[2] = sun * sun_phase.z;
     return out_light;
 }
 
@@ -172,7 +177,7 @@ void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigm
         SpeciesGpu sp = frame.species[i];
         float rho = piece_density(sp, profile_piece(sp, y_piece), y);
         sigma_t += vec3(sp.sigma_t) * rho;
-        j += vec3(sp.sigma_s) * rho * light.light[i];
+        j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i]);
     }
 }
 
@@ -198,6 +203,7 @@ bool atmosphere_interval(vec3 o, vec3 d, float s_end, OUT(float) s_in, OUT(float
 // len (< NO_HIT: capped) starting at altitude y_a with direction cosine mu,
 // the stretch lying inside one profile piece of every species (chosen at
 // y_piece): sigma_t rho(y_a) len expm1(-mu len / H) / (-mu len / H), exact.
+// (rho(y_a) e^x = rho(y_b): the same from the denser end.)
 vec3 stretch_optical_depth(float y_a, float y_piece, float mu, float len) {
     float l = min(len, 1.0e30f);
     vec3 tau = vec3(0.0f);
@@ -205,7 +211,11 @@ vec3 stretch_optical_depth(float y_a, float y_piece, float mu, float len) {
         if (!species_present(i)) continue;
         SpeciesGpu sp = frame.species[i];
         int k = profile_piece(sp, y_piece);
-        tau += vec3(sp.sigma_t) * (piece_density(sp, k, y_a) * l * expm1_over_x(-mu * l * sp.inv_scales[k]));
+        // Integrated from the denser end, so the factor expm1(x) / x has x <= 0
+        // and cannot overflow (a descent through many scale heights).
+        float x = -mu * l * sp.inv_scales[k];
+        float y_dense = x > 0.0f ? y_a + mu * l : y_a;
+        tau += vec3(sp.sigma_t) * (piece_density(sp, k, y_dense) * l * expm1_over_x(-abs(x)));
     }
     return tau;
 }
@@ -251,8 +261,12 @@ void volume_end(vec3 o, float mu, float s_in, float s_out, float y_a, OUT(float)
 // A = 1 - e^{-dtau}, B = A / dtau - e^{-dtau} (series for small dtau).
 float source_integral(float dtau, float s_a, float s_b) {
     if (s_a > 0.0f && s_b > 0.0f) {
-        float r = log(s_b / s_a);
-        return s_a * min(dtau, 1.0e30f) * expm1_over_x(r - dtau);
+        float t = min(dtau, 1.0e30f);
+        float x = log(s_b / s_a) - t;
+        // s_a e^x = s_b e^{-dtau}: for x > 1 that form cannot overflow (the
+        // ends may differ by any factor: a species fading out).
+        if (x > 1.0f) return t * (s_b * exp(-t) - s_a) / x;
+        return s_a * t * expm1_over_x(x);
     }
     float e = exp(-dtau);
     float a;
@@ -318,7 +332,8 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
         SpeciesLight light_b = light_a;
         if (y_b != y_a) light_b = species_light(t, atmosphere_column(y_b), sun_phase);
         // Each species' share of the source, sigma_s,i rho_i L_i / sigma_t,
-        // taken exponential in optical depth on its own (docs/daytime.md).
+        // its sky and sun parts each taken exponential in optical depth on
+        // their own (docs/daytime.md).
         vec3 sigma_a = sigma_medium;
         vec3 sigma_b = sigma_medium;
         for (int i = 0; i < 3; ++i) {
@@ -331,9 +346,14 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
             if (!species_present(i)) continue;
             SpeciesGpu sp = frame.species[i];
             int piece = profile_piece(sp, y_piece);
-            vec3 j_a = vec3(sp.sigma_s) * piece_density(sp, piece, y_a) * light_a.light[i];
-            vec3 j_b = vec3(sp.sigma_s) * piece_density(sp, piece, y_b) * light_b.light[i];
-            inscatter += weight * source_integral3(dtau, source_function(j_a, sigma_a), source_function(j_b, sigma_b));
+            vec3 scale_a = vec3(sp.sigma_s) * piece_density(sp, piece, y_a);
+            vec3 scale_b = vec3(sp.sigma_s) * piece_density(sp, piece, y_b);
+            inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sky[i], sigma_a),
+                                                   source_function(scale_b * light_b.sky[i], sigma_b));
+            if (HAS_SUN) {
+                inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sun[i], sigma_a),
+                                                       source_function(scale_b * light_b.sun[i], sigma_b));
+            }
         }
         weight *= exp(-dtau);
         transmittance *= exp(-tau);
@@ -396,17 +416,18 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
         for (int i = 0; i < 3; ++i) sun_phase[i] = species_phase(frame.species[i].phase, cos_sun);
     }
     float ds = (s_far - s_in) / float(steps);
-    vec3 weight = exp(-sigma_medium * s_in);
+    vec3 tau_medium = sigma_medium * s_in;
+    vec3 tau = vec3(0.0f);  // the atmosphere's, from s_in (summed, not multiplied: no drift in float32)
     for (int step = 0; step < steps; ++step) {
         float s = s_in + (float(step) + 0.5f) * ds;
         float y = clamp(o.y + d.y * s, 0.0f, frame.atmosphere.x);
         vec3 sigma;
         vec3 j;
         atmosphere_point(y, y, species_light(t, atmosphere_column(y), sun_phase), sigma, j);
-        vec3 half_step = exp(-(sigma + sigma_medium) * (0.5f * ds));
-        inscatter += weight * half_step * j * ds;
-        weight *= half_step * half_step;
-        transmittance *= exp(-sigma * ds);
+        inscatter += exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds)) *
+                     j * ds;
+        tau += sigma * ds;
     }
+    transmittance = exp(-tau);
     if (s_far < s_out) transmittance = vec3(0.0f);
 }
