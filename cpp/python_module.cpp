@@ -1,13 +1,13 @@
 // airlight._core: the pybind11 bridge. Scenes arrive as Python objects and are
 // converted to JSON values in C++ so that NaN/Inf survive to the validator;
 // scene errors become TypeError/ValueError naming the field.
-#include <map>
 #include <pybind11/numpy.h>
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
 #include <cstring>
 #include <limits>
+#include <map>
 #include <memory>
 #include <optional>
 

@@ -94,6 +94,18 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
               same(x.albedo, y.albedo)))
             return false;
     }
+    const airlight::Atmosphere &aa = a.atmosphere, &ab = b.atmosphere;
+    if (!(a.sky.model == b.sky.model && a.sky.cie_type == b.sky.cie_type &&
+          same(a.sky.zenith_radiance, b.sky.zenith_radiance) && a.sun.present == b.sun.present &&
+          same(a.sun.direction, b.sun.direction) && same(a.sun.irradiance, b.sun.irradiance) &&
+          a.quality.sky_segments == b.quality.sky_segments && aa.molecules.present == ab.molecules.present &&
+          aa.molecules.density_scale == ab.molecules.density_scale && aa.aerosol.present == ab.aerosol.present &&
+          aa.aerosol.visibility == ab.aerosol.visibility && aa.aerosol.coefficient == ab.aerosol.coefficient &&
+          aa.aerosol.scale_height == ab.aerosol.scale_height && aa.aerosol.g == ab.aerosol.g &&
+          aa.aerosol.albedo == ab.aerosol.albedo && aa.rain.present == ab.rain.present &&
+          aa.rain.rate == ab.rain.rate && aa.rain.density_scale == ab.rain.density_scale &&
+          aa.rain.top == ab.rain.top && aa.rain.g == ab.rain.g))
+        return false;
     const airlight::DisplaySettings &da = a.display, &db = b.display;
     return da.exposure_mode == db.exposure_mode &&
            (da.exposure_mode == airlight::ExposureMode::automatic || da.exposure == db.exposure) &&
@@ -558,6 +570,68 @@ const std::vector<BadCase> bad_cases = {
      "display.glare.pupil_diameter", "must be finite"},
     {"eyelashes number", [](json& j) { j["display"] = {{"glare", {{"eyelashes", 1}}}}; }, Kind::type,
      "display.glare.eyelashes", "expected true or false"},
+    // Daytime (issue 6).
+    {"sky model unknown", [](json& j) { j["sky"] = {{"model", "clear"}, {"zenith_radiance", 1}}; }, Kind::value,
+     "sky.model", "allowed: overcast, cie"},
+    {"sky type 0", [](json& j) { j["sky"] = {{"model", "cie"}, {"type", 0}, {"zenith_radiance", 1}}; }, Kind::value,
+     "sky.type", "must be in [1, 15]"},
+    {"sky type 16", [](json& j) { j["sky"] = {{"model", "cie"}, {"type", 16}, {"zenith_radiance", 1}}; },
+     Kind::value, "sky.type", "must be in [1, 15]"},
+    {"sky type fraction", [](json& j) { j["sky"] = {{"model", "cie"}, {"type", 2.5}, {"zenith_radiance", 1}}; },
+     Kind::value, "sky.type", "integer"},
+    {"sky type missing", [](json& j) { j["sky"] = {{"model", "cie"}, {"zenith_radiance", 1}}; }, Kind::value,
+     "sky.type", "missing"},
+    {"sky type on overcast", [](json& j) { j["sky"] = {{"model", "overcast"}, {"type", 3}, {"zenith_radiance", 1}}; },
+     Kind::value, "sky.type", "unknown key"},
+    {"sky type without sun", [](json& j) { j["sky"] = {{"model", "cie"}, {"type", 12}, {"zenith_radiance", 1}}; },
+     Kind::value, "sky.type", "sun"},
+    {"zenith radiance negative", [](json& j) { j["sky"] = {{"model", "overcast"}, {"zenith_radiance", -1}}; },
+     Kind::value, "sky.zenith_radiance", "must be >= 0"},
+    {"zenith radiance missing", [](json& j) { j["sky"] = {{"model", "overcast"}}; }, Kind::value,
+     "sky.zenith_radiance", "missing"},
+    {"sun zero direction", [](json& j) { j["sun"] = {{"direction", {0, 0, 0}}}; }, Kind::value, "sun.direction",
+     "zero length"},
+    {"sun direction and angles", [](json& j) { j["sun"] = {{"direction", {0, 1, 0}}, {"elevation", 30}}; },
+     Kind::value, "sun.direction", "not both"},
+    {"sun elevation 100", [](json& j) { j["sun"] = {{"elevation", 100}, {"azimuth", 0}}; }, Kind::value,
+     "sun.elevation", "must be in [-90, 90]"},
+    {"sun azimuth missing", [](json& j) { j["sun"] = {{"elevation", 30}}; }, Kind::value, "sun.azimuth", "missing"},
+    {"sun irradiance negative", [](json& j) { j["sun"] = {{"elevation", 30}, {"azimuth", 0}, {"irradiance", -2}}; },
+     Kind::value, "sun.irradiance", "must be >= 0"},
+    {"atmosphere unknown species", [](json& j) { j["atmosphere"] = {{"snow", json::object()}}; }, Kind::value,
+     "atmosphere.snow", "unknown key"},
+    {"rain rate negative", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", -1}}}}; }, Kind::value,
+     "atmosphere.rain.rate", "must be in [0, 1000]"},
+    {"rain rate missing", [](json& j) { j["atmosphere"] = {{"rain", json::object()}}; }, Kind::value,
+     "atmosphere.rain.rate", "missing"},
+    {"rain rate string", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", "heavy"}}}}; }, Kind::type,
+     "atmosphere.rain.rate", "expected a number"},
+    {"rain top zero", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"top", 0}}}}; }, Kind::value,
+     "atmosphere.rain.top", "must be > 0"},
+    {"rain g one", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"g", 1}}}}; }, Kind::value,
+     "atmosphere.rain.g", "(-1, 1)"},
+    {"visibility negative", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", -5000}}}}; }, Kind::value,
+     "atmosphere.aerosol.visibility", "must be > 0"},
+    {"visibility zero", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 0}}}}; }, Kind::value,
+     "atmosphere.aerosol.visibility", "must be > 0"},
+    {"aerosol without amount", [](json& j) { j["atmosphere"] = {{"aerosol", {{"g", 0.7}}}}; }, Kind::value,
+     "atmosphere.aerosol.visibility", "missing"},
+    {"aerosol both amounts",
+     [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"coefficient", 0.01}}}}; }, Kind::value,
+     "atmosphere.aerosol.coefficient", "not both"},
+    {"aerosol coefficient negative", [](json& j) { j["atmosphere"] = {{"aerosol", {{"coefficient", -0.01}}}}; },
+     Kind::value, "atmosphere.aerosol.coefficient", "must be in [0, 1000]"},
+    {"aerosol scale height zero",
+     [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"scale_height", 0}}}}; }, Kind::value,
+     "atmosphere.aerosol.scale_height", "must be > 0"},
+    {"aerosol albedo 2", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"albedo", 2}}}}; },
+     Kind::value, "atmosphere.aerosol.albedo", "must be in [0, 1]"},
+    {"molecules negative", [](json& j) { j["atmosphere"] = {{"molecules", {{"density_scale", -1}}}}; }, Kind::value,
+     "atmosphere.molecules.density_scale", "must be in [0, 1e+06]"},
+    {"sky segments 1", [](json& j) { j["quality"] = {{"sky_segments", 1}}; }, Kind::value, "quality.sky_segments",
+     "must be in [2, 64]"},
+    {"sky segments 100", [](json& j) { j["quality"] = {{"sky_segments", 100}}; }, Kind::value,
+     "quality.sky_segments", "must be in [2, 64]"},
 };
 
 void test_bad_cases() {
@@ -671,6 +745,33 @@ void test_defaults_and_accepted_forms() {
     j["camera"]["position"] = {1e7, -1e7, 0};  // coordinate bound inclusive
     j["camera"]["look_at"] = {0, 0, 0};
     CHECK(airlight::parse_scene_json(j).camera.position.x == 1e7f);
+}
+
+// The issue's example of the daytime keys (issue 6).
+void test_daytime_example() {
+    json j = json::parse(readme_example);
+    j["sky"] = {{"model", "cie"}, {"type", 12}, {"zenith_radiance", {1, 1, 1}}};
+    j["sun"] = {{"elevation", 30}, {"azimuth", 0}, {"irradiance", {5, 5, 5}}};
+    j["atmosphere"] = {{"molecules", {{"density_scale", 1}}},
+                       {"aerosol", {{"visibility", 5000}, {"scale_height", 1200}, {"g", 0.7}}},
+                       {"rain", {{"rate", 10}}}};
+    const airlight::Scene s = airlight::parse_scene_json(j);
+    CHECK(s.sky.model == airlight::SkyModel::cie && s.sky.cie_type == 12);
+    CHECK(std::abs(s.sun.direction.x) < 1e-7f && std::abs(s.sun.direction.y - 0.5f) < 1e-6f &&
+          std::abs(s.sun.direction.z + 0.8660254f) < 1e-6f);
+    CHECK(s.atmosphere.molecules.present && s.atmosphere.aerosol.present && s.atmosphere.rain.present);
+    CHECK(s.atmosphere.aerosol.visibility == 5000.0f && s.atmosphere.aerosol.scale_height == 1200.0f);
+    CHECK(s.atmosphere.rain.rate == 10.0f && s.atmosphere.rain.top == 1500.0f && s.atmosphere.rain.g == 0.87f);
+    CHECK(same_scene(s, airlight::parse_scene(airlight::scene_to_json(s))));
+    // Azimuth 90 puts the sun along +x; null keys are absent.
+    j["sun"] = {{"elevation", 0}, {"azimuth", 90}};
+    j["atmosphere"] = nullptr;
+    const airlight::Scene t = airlight::parse_scene_json(j);
+    CHECK(std::abs(t.sun.direction.x - 1.0f) < 1e-6f && !t.atmosphere.any());
+    j["sky"] = {{"model", "overcast"}, {"zenith_radiance", 2}};
+    j["sun"] = nullptr;
+    const airlight::Scene u = airlight::parse_scene_json(j);
+    CHECK(u.sky.model == airlight::SkyModel::overcast && !u.sun.present);
 }
 
 void test_spot_lights() {
@@ -821,6 +922,22 @@ void test_round_trip() {
         if (i % 2 == 0)
             j["display"]["glare"] = {{"pupil_diameter", i % 6 == 0 ? json("auto") : json(1.0 + 8.0 * unit(rng))},
                                      {"eyelashes", i % 4 == 0}};
+        if (i % 3 != 2) {  // daytime keys, every kind
+            const int type = 1 + i % 15;
+            j["sky"] = i % 2 ? json{{"model", "overcast"}, {"zenith_radiance", unit(rng)}}
+                             : json{{"model", "cie"}, {"type", type}, {"zenith_radiance", {unit(rng), 1, 2}}};
+            j["sun"] = i % 4 < 2 ? json{{"elevation", 180.0 * unit(rng) - 90.0}, {"azimuth", coord(rng)}}
+                                 : json{{"direction", vec()}, {"irradiance", std::pow(10.0, expo(rng))}};
+            j["atmosphere"] = {{"molecules", {{"density_scale", unit(rng)}}},
+                               {"aerosol",
+                                {{i % 5 ? "visibility" : "coefficient", std::pow(10.0, expo(rng) - 1.0)},
+                                 {"scale_height", 1e4 * unit(rng) + 1.0},
+                                 {"g", 2.0 * unit(rng) - 1.0},
+                                 {"albedo", unit(rng)}}},
+                               {"rain", {{"rate", 100.0 * unit(rng)}, {"top", 1.0 + 3e3 * unit(rng)}}}};
+            if (i % 7 == 0) j["atmosphere"].erase("aerosol");
+            j["quality"] = {{"sky_segments", 2 + i % 63}};
+        }
         airlight::Scene a;
         try {
             a = airlight::parse_scene_json(j);
@@ -866,6 +983,7 @@ void test_files() {
 }  // namespace
 
 int main() {
+    test_daytime_example();
     test_bad_cases();
     test_text_errors();
     test_readme_example();
