@@ -298,9 +298,10 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // (`transmittance`; the medium's is applied by the caller). Scattering
 // volumes (MODELS.md section 3, seed equations 3 to 6, corrected): the ray
 // is cut where it crosses the altitude levels (which include every profile
-// break), and in each volume the source function J / sigma_t is taken linear
-// in optical depth between its ends, integrated exactly against e^{-tau}
-// (the seed's constant-source form is the first term). sigma_medium: the
+// break), and in each volume each species' sky and sun shares of the source
+// function J / sigma_t are taken exponential in optical depth between its
+// ends, integrated exactly against e^{-tau} (source_integral; the seed's
+// constant-source form is the case r = 0). sigma_medium: the
 // homogeneous medium's extinction, which attenuates but scatters no sky light.
 void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(vec3) inscatter,
                            OUT(vec3) transmittance) {
