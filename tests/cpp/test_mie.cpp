@@ -93,18 +93,19 @@ void check_against_numpy_reference() {
 // in D over 0.1-3.5 mm; weight N(D) D^2 Q_sca), 550 nm, 25 mm/h, on 120-145
 // degrees every 0.1 degree; how much it changes when n doubles, pointwise
 // and in 1-degree bins.
-std::vector<double> marshall_palmer_average(int n, double wavelength_nm, double rate,
-                                            const std::vector<double>& theta) {
+std::vector<double> marshall_palmer_average(int n, double wavelength_nm, double rate, const std::vector<double>& theta,
+                                            bool log_sizes = false) {
     const double lambda = 4.1 * std::pow(rate, -0.21);
     std::vector<std::vector<double>> phases(static_cast<size_t>(n), std::vector<double>());
     std::vector<double> weights(static_cast<size_t>(n), 0.0);
     std::atomic<int> next{0};
     auto work = [&] {
         for (int i = next++; i < n; i = next++) {
-            const double d = 0.1 + 3.4 * (i + 0.5) / n;
+            // uniform in D, or in log D (then dD = D d(log D))
+            const double d = log_sizes ? 0.1 * std::pow(35.0, (i + 0.5) / n) : 0.1 + 3.4 * (i + 0.5) / n;
             const double x = kPi * d * 1e-3 / (wavelength_nm * 1e-9);
             const MieCoefficients c = mie_coefficients({1.333, 0.0}, x);
-            weights[size_t(i)] = std::exp(-lambda * d) * mie_efficiencies(c).scattering * d * d;
+            weights[size_t(i)] = std::exp(-lambda * d) * mie_efficiencies(c).scattering * d * d * (log_sizes ? d : 1.0);
             phases[size_t(i)] = mie_phase_function({1.333, 0.0}, x, theta);
         }
     };
@@ -148,11 +149,47 @@ void size_convergence_analysis() {
     }
 }
 
+// The same seen through the sun's disc (0.53 degrees: the 1-D profile of a
+// uniform disc of radius 0.2665 degrees convolved in scattering angle), sizes
+// uniform in log D, 125-142 degrees every 0.02 degree: the change when n doubles.
+void disc_smoothed_convergence_analysis() {
+    const double step = 0.02, radius = 0.2665;
+    std::vector<double> theta;
+    for (int i = 0; i <= 850; ++i) theta.push_back((125.0 + step * i) * kPi / 180.0);
+    const int h = int(radius / step);
+    std::vector<double> kernel;
+    double kernel_sum = 0.0;
+    for (int j = -h; j <= h; ++j) {
+        const double t = j * step / radius;
+        kernel.push_back(std::sqrt(std::max(0.0, 1.0 - t * t)));
+        kernel_sum += kernel.back();
+    }
+    std::vector<double> previous;
+    std::printf("\n| sizes (log-uniform) | seconds | change of the disc-smoothed phase |\n|---|---|---|\n");
+    for (int n : {200, 400, 800, 1600}) {
+        const auto start = std::chrono::steady_clock::now();
+        const std::vector<double> p = marshall_palmer_average(n, 550.0, 25.0, theta, true);
+        std::vector<double> smooth(p.size(), 0.0);
+        for (size_t k = size_t(h); k + size_t(h) < p.size(); ++k) {
+            for (int j = -h; j <= h; ++j) smooth[k] += kernel[size_t(j + h)] * p[size_t(int(k) + j)];
+            smooth[k] /= kernel_sum;
+        }
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        double change = 0.0;
+        if (!previous.empty())
+            for (size_t k = size_t(h); k + size_t(h) < p.size(); ++k)
+                change = std::max(change, std::abs(previous[k] / smooth[k] - 1.0));
+        std::printf("| %d | %.1f | %.4f |\n", n, seconds, change);
+        previous = smooth;
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
     if (argc > 1 && std::strcmp(argv[1], "--analysis") == 0) {
         size_convergence_analysis();
+        disc_smoothed_convergence_analysis();
         return 0;
     }
     check_bhmie_example();
