@@ -520,7 +520,13 @@ Sun parse_sun(const Obj& o) {
         // kept as given, so that a written scene reloads bit for bit.
         sun.direction = std::abs(glm::length(d) - 1.0) < 1e-6 ? glm::vec3(d) : glm::vec3(glm::normalize(d));
     } else {
-        const double el = read_in_range(o.req("elevation"), -90.0, 90.0, " degrees") * (M_PI / 180.0);
+        if (!elevation && !azimuth)
+            fail(Kind::value, join_path(o.path, "elevation"),
+                 "missing: give elevation and azimuth (degrees) or a direction");
+        const Value el_value = o.req("elevation");
+        read_in_range(el_value, -90.0, 90.0, " degrees");
+        // In double from the given numbers, stored as float.
+        const double el = read_number(el_value) * (M_PI / 180.0);
         const double az = read_number(o.req("azimuth")) * (M_PI / 180.0);
         sun.direction =
             glm::vec3(float(std::sin(az) * std::cos(el)), float(std::sin(el)), float(-std::cos(az) * std::cos(el)));

@@ -632,6 +632,71 @@ const std::vector<BadCase> bad_cases = {
      "must be in [2, 64]"},
     {"sky segments 100", [](json& j) { j["quality"] = {{"sky_segments", 100}}; }, Kind::value,
      "quality.sky_segments", "must be in [2, 64]"},
+    {"sky segments fraction", [](json& j) { j["quality"] = {{"sky_segments", 8.5}}; }, Kind::value,
+     "quality.sky_segments", "integer"},
+    {"sky segments string", [](json& j) { j["quality"] = {{"sky_segments", "many"}}; }, Kind::type,
+     "quality.sky_segments", "expected a number"},
+    {"sky not an object", [](json& j) { j["sky"] = "blue"; }, Kind::type, "sky", "expected an object"},
+    {"sky model missing", [](json& j) { j["sky"] = {{"zenith_radiance", 1}}; }, Kind::value, "sky.model", "missing"},
+    {"sky unknown key", [](json& j) { j["sky"] = {{"model", "overcast"}, {"zenith_radiance", 1}, {"zenit", 1}}; },
+     Kind::value, "sky.zenit", "unknown key"},
+    {"sky type 2 without sun", [](json& j) { j["sky"] = {{"model", "cie"}, {"type", 2}, {"zenith_radiance", 1}}; },
+     Kind::value, "sky.type", "\"sun\""},
+    {"zenith radiance NaN",
+     [](json& j) { j["sky"] = {{"model", "overcast"}, {"zenith_radiance", {1, std::nan(""), 1}}}; }, Kind::value,
+     "sky.zenith_radiance", "must be finite"},
+    {"zenith radiance overflows float", [](json& j) { j["sky"] = {{"model", "overcast"}, {"zenith_radiance", 1e39}}; },
+     Kind::value, "sky.zenith_radiance", "32-bit float"},
+    {"sun not an object", [](json& j) { j["sun"] = json::array({0, 1, 0}); }, Kind::type, "sun", "expected an object"},
+    {"sun empty", [](json& j) { j["sun"] = json::object(); }, Kind::value, "sun.elevation", "or a direction"},
+    {"sun elevation missing", [](json& j) { j["sun"] = {{"azimuth", 30}}; }, Kind::value, "sun.elevation",
+     "missing"},
+    {"sun direction and azimuth", [](json& j) { j["sun"] = {{"direction", {0, 1, 0}}, {"azimuth", 30}}; },
+     Kind::value, "sun.direction", "not both"},
+    {"sun direction of 2", [](json& j) { j["sun"] = {{"direction", {0, 1}}}; }, Kind::value, "sun.direction",
+     "exactly 3"},
+    {"sun elevation -90.5", [](json& j) { j["sun"] = {{"elevation", -90.5}, {"azimuth", 0}}; }, Kind::value,
+     "sun.elevation", "must be in [-90, 90]"},
+    {"sun azimuth string", [](json& j) { j["sun"] = {{"elevation", 10}, {"azimuth", "north"}}; }, Kind::type,
+     "sun.azimuth", "expected a number"},
+    {"sun unknown key", [](json& j) { j["sun"] = {{"elevation", 10}, {"azimuth", 0}, {"irradience", 1}}; },
+     Kind::value, "sun.irradience", "did you mean 'irradiance'"},
+    {"atmosphere not an object", [](json& j) { j["atmosphere"] = 1; }, Kind::type, "atmosphere",
+     "expected an object"},
+    {"molecules not an object", [](json& j) { j["atmosphere"] = {{"molecules", 1}}; }, Kind::type,
+     "atmosphere.molecules", "expected an object"},
+    {"molecules unknown key", [](json& j) { j["atmosphere"] = {{"molecules", {{"density", 1}}}}; }, Kind::value,
+     "atmosphere.molecules.density", "unknown key"},
+    {"molecules density huge", [](json& j) { j["atmosphere"] = {{"molecules", {{"density_scale", 2e6}}}}; },
+     Kind::value, "atmosphere.molecules.density_scale", "must be in [0, 1e+06]"},
+    {"visibility huge", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 2e9}}}}; }, Kind::value,
+     "atmosphere.aerosol.visibility", "must be <= 1e+09"},
+    {"visibility string", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", "far"}}}}; }, Kind::type,
+     "atmosphere.aerosol.visibility", "expected a number"},
+    {"aerosol coefficient huge", [](json& j) { j["atmosphere"] = {{"aerosol", {{"coefficient", 1e4}}}}; },
+     Kind::value, "atmosphere.aerosol.coefficient", "must be in [0, 1000]"},
+    {"aerosol scale height huge",
+     [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"scale_height", 1e6}}}}; }, Kind::value,
+     "atmosphere.aerosol.scale_height", "must be <= 100000"},
+    {"aerosol g minus one", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"g", -1}}}}; },
+     Kind::value, "atmosphere.aerosol.g", "(-1, 1)"},
+    {"aerosol albedo negative",
+     [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibility", 100}, {"albedo", -0.1}}}}; }, Kind::value,
+     "atmosphere.aerosol.albedo", "must be in [0, 1]"},
+    {"aerosol unknown key", [](json& j) { j["atmosphere"] = {{"aerosol", {{"visibilty", 100}}}}; }, Kind::value,
+     "atmosphere.aerosol.visibilty", "did you mean 'visibility'"},
+    {"rain rate huge", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1001}}}}; }, Kind::value,
+     "atmosphere.rain.rate", "must be in [0, 1000]"},
+    {"rain density negative", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"density_scale", -1}}}}; },
+     Kind::value, "atmosphere.rain.density_scale", "must be in [0, 1e+06]"},
+    {"rain density huge", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"density_scale", 1e7}}}}; },
+     Kind::value, "atmosphere.rain.density_scale", "must be in [0, 1e+06]"},
+    {"rain top negative", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"top", -5}}}}; }, Kind::value,
+     "atmosphere.rain.top", "must be > 0"},
+    {"rain top huge", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"top", 1e6}}}}; }, Kind::value,
+     "atmosphere.rain.top", "must be <= 100000"},
+    {"rain unknown key", [](json& j) { j["atmosphere"] = {{"rain", {{"rate", 1}, {"intensity", 1}}}}; },
+     Kind::value, "atmosphere.rain.intensity", "unknown key"},
 };
 
 void test_bad_cases() {
@@ -772,6 +837,66 @@ void test_daytime_example() {
     j["sun"] = nullptr;
     const airlight::Scene u = airlight::parse_scene_json(j);
     CHECK(u.sky.model == airlight::SkyModel::overcast && !u.sun.present);
+
+    // The sunless CIE types (indicatrix group 1) need no sun; the others do.
+    for (int type = 1; type <= 15; ++type) {
+        json k = json::parse(readme_example);
+        k["sky"] = {{"model", "cie"}, {"type", type}, {"zenith_radiance", 1}};
+        bool ok = true;
+        try {
+            airlight::parse_scene_json(k);
+        } catch (const SceneError& e) {
+            ok = false;
+            CHECK(e.field() == "sky.type");
+        }
+        CHECK_MSG(ok == (type == 1 || type == 3 || type == 5), "CIE type " + std::to_string(type));
+    }
+
+    // Bounds accepted; a direction is normalised; null sky and sun are absent.
+    json k = json::parse(readme_example);
+    k["sky"] = nullptr;
+    k["sun"] = {{"direction", {0, 3, -4}}};
+    k["atmosphere"] = json::object();
+    airlight::Scene v = airlight::parse_scene_json(k);
+    CHECK(v.sky.model == airlight::SkyModel::none && v.sun.present && !v.atmosphere.any());
+    CHECK(same(v.sun.direction, {0.0f, 0.6f, -0.8f}) && same(v.sun.irradiance, glm::vec3(0.0f)));
+    CHECK(v.quality.sky_segments == 16);
+    k["sun"] = {{"elevation", -90}, {"azimuth", 1e6}, {"irradiance", 0}};
+    k["atmosphere"] = {{"molecules", {{"density_scale", 0}}},
+                       {"aerosol", {{"coefficient", 0}, {"g", -0.5}, {"albedo", 1}}},
+                       {"rain", {{"rate", 1000}, {"density_scale", 1e6}, {"top", 1e5}}}};
+    k["quality"] = {{"sky_segments", 64}};
+    v = airlight::parse_scene_json(k);
+    CHECK(std::abs(v.sun.direction.y + 1.0f) < 1e-7f && glm::length(v.sun.direction) > 0.999999f);
+    CHECK(v.atmosphere.molecules.density_scale == 0.0f && v.atmosphere.aerosol.coefficient == 0.0f &&
+          v.atmosphere.aerosol.visibility == 0.0f && v.atmosphere.aerosol.scale_height == 1000.0f &&
+          v.atmosphere.aerosol.albedo == 1.0f && v.atmosphere.aerosol.g == -0.5f);
+    CHECK(v.atmosphere.rain.rate == 1000.0f && v.atmosphere.rain.density_scale == 1e6f &&
+          v.atmosphere.rain.top == 1e5f && v.quality.sky_segments == 64);
+    k["atmosphere"] = {{"molecules", nullptr}, {"aerosol", {{"visibility", 1e9}}}, {"rain", nullptr}};
+    k["quality"] = {{"sky_segments", 2}};
+    v = airlight::parse_scene_json(k);
+    CHECK(!v.atmosphere.molecules.present && !v.atmosphere.rain.present && v.atmosphere.aerosol.present &&
+          v.atmosphere.aerosol.visibility == 1e9f && v.quality.sky_segments == 2);
+
+    // Writing: null sky, sun and atmosphere when absent; the sun as its unit
+    // direction; only the present species; the aerosol's amount as given.
+    json w = airlight::scene_to_json_value(airlight::parse_scene(readme_example));
+    CHECK(w["sky"].is_null() && w["sun"].is_null() && w["atmosphere"].is_null());
+    CHECK(w["quality"]["sky_segments"] == 16);
+    w = airlight::scene_to_json_value(s);  // the example
+    CHECK(w["sky"]["model"] == "cie" && w["sky"]["type"] == 12 && w["sky"]["zenith_radiance"].size() == 3);
+    CHECK(w["sun"].size() == 2 && w["sun"]["direction"].size() == 3 && w["sun"]["irradiance"][0] == 5.0);
+    CHECK(w["atmosphere"]["aerosol"]["visibility"] == 5000.0 && !w["atmosphere"]["aerosol"].contains("coefficient"));
+    CHECK(w["atmosphere"]["rain"]["top"] == 1500.0 && w["atmosphere"]["molecules"]["density_scale"] == 1.0);
+    k["sky"] = {{"model", "overcast"}, {"zenith_radiance", {1, 2, 3}}};
+    k["atmosphere"] = {{"aerosol", {{"coefficient", 1e-4}}}};
+    v = airlight::parse_scene_json(k);
+    w = airlight::scene_to_json_value(v);
+    CHECK(w["sky"].size() == 2 && !w["sky"].contains("type"));
+    CHECK(w["atmosphere"].size() == 1 && w["atmosphere"]["aerosol"]["coefficient"] == 1e-4 &&
+          !w["atmosphere"]["aerosol"].contains("visibility"));
+    CHECK(same_scene(v, airlight::parse_scene_json(w)));
 }
 
 void test_spot_lights() {

@@ -195,6 +195,47 @@ BAD_SCENES = [
      "atmosphere.molecules.density_scale"),
     ("misspelt_species", _set("atmosphere", {"rian": {"rate": 2}}), ValueError, "atmosphere.rian"),
     ("sky_segments_too_few", _set("quality", {"sky_segments": 1}), ValueError, "quality.sky_segments"),
+    ("sky_segments_too_many", _set("quality", {"sky_segments": 65}), ValueError, "quality.sky_segments"),
+    ("sky_segments_float", _set("quality", {"sky_segments": 8.5}), ValueError, "quality.sky_segments"),
+    ("sky_not_object", _set("sky", "blue"), TypeError, "sky"),
+    ("sky_type_on_overcast", _set("sky", {"model": "overcast", "type": 1, "zenith_radiance": 1}), ValueError,
+     "sky.type"),
+    ("sky_type_missing", _set("sky", {"model": "cie", "zenith_radiance": 1}), ValueError, "sky.type"),
+    ("sky_type_fraction", _set("sky", {"model": "cie", "type": 1.5, "zenith_radiance": 1}), ValueError,
+     "sky.type"),
+    ("sky_zenith_radiance_missing", _set("sky", {"model": "overcast"}), ValueError, "sky.zenith_radiance"),
+    ("sky_zenith_radiance_inf", _set("sky", {"model": "overcast", "zenith_radiance": INF}), ValueError,
+     "sky.zenith_radiance"),
+    ("sun_empty", _set("sun", {}), ValueError, "sun.elevation"),
+    ("sun_azimuth_missing", _set("sun", {"elevation": 20}), ValueError, "sun.azimuth"),
+    ("sun_azimuth_nan", _set("sun", {"elevation": 20, "azimuth": NAN}), ValueError, "sun.azimuth"),
+    ("sun_direction_and_angles", _set("sun", {"direction": [0, 1, 0], "elevation": 20, "azimuth": 0}),
+     ValueError, "sun.direction"),
+    ("misspelt_sun_key", _set("sun", {"elevation": 20, "azimuth": 0, "irradience": 1}), ValueError,
+     "sun.irradience"),
+    ("atmosphere_not_object", _set("atmosphere", [1]), TypeError, "atmosphere"),
+    ("molecules_not_object", _set("atmosphere", {"molecules": 1}), TypeError, "atmosphere.molecules"),
+    ("huge_molecule_density", _set("atmosphere", {"molecules": {"density_scale": 1e7}}), ValueError,
+     "atmosphere.molecules.density_scale"),
+    ("aerosol_without_amount", _set("atmosphere", {"aerosol": {"g": 0.5}}), ValueError,
+     "atmosphere.aerosol.visibility"),
+    ("aerosol_both_amounts", _set("atmosphere", {"aerosol": {"visibility": 100, "coefficient": 0.01}}),
+     ValueError, "atmosphere.aerosol.coefficient"),
+    ("huge_visibility", _set("atmosphere", {"aerosol": {"visibility": 1e10}}), ValueError,
+     "atmosphere.aerosol.visibility"),
+    ("negative_aerosol_coefficient", _set("atmosphere", {"aerosol": {"coefficient": -1e-3}}), ValueError,
+     "atmosphere.aerosol.coefficient"),
+    ("zero_scale_height", _set("atmosphere", {"aerosol": {"visibility": 100, "scale_height": 0}}), ValueError,
+     "atmosphere.aerosol.scale_height"),
+    ("aerosol_albedo_above_one", _set("atmosphere", {"aerosol": {"visibility": 100, "albedo": 1.5}}),
+     ValueError, "atmosphere.aerosol.albedo"),
+    ("rain_rate_missing", _set("atmosphere", {"rain": {"top": 1000}}), ValueError, "atmosphere.rain.rate"),
+    ("huge_rain_rate", _set("atmosphere", {"rain": {"rate": 1e4}}), ValueError, "atmosphere.rain.rate"),
+    ("rain_rate_string", _set("atmosphere", {"rain": {"rate": "heavy"}}), TypeError, "atmosphere.rain.rate"),
+    ("negative_rain_density", _set("atmosphere", {"rain": {"rate": 1, "density_scale": -1}}), ValueError,
+     "atmosphere.rain.density_scale"),
+    ("zero_rain_top", _set("atmosphere", {"rain": {"rate": 1, "top": 0}}), ValueError, "atmosphere.rain.top"),
+    ("rain_g_minus_one", _set("atmosphere", {"rain": {"rate": 1, "g": -1}}), ValueError, "atmosphere.rain.g"),
 ]
 
 
@@ -491,3 +532,104 @@ def test_light_radius_default_and_bounds_follow_the_format() -> None:
     scene["lights"][0]["radius"] = 1000.5
     with pytest.raises(ValueError, match="^lights\\[0\\].radius:"):
         airlight.load_scene(scene)
+
+
+# --- daytime keys (issue 6) ---------------------------------------------------------------
+
+ISSUE_EXAMPLE = {
+    "sky": {"model": "cie", "type": 12, "zenith_radiance": [1, 1, 1]},
+    "sun": {"elevation": 30, "azimuth": 0, "irradiance": [5, 5, 5]},
+    "atmosphere": {"molecules": {"density_scale": 1},
+                   "aerosol": {"visibility": 5000, "scale_height": 1200, "g": 0.7},
+                   "rain": {"rate": 10}},
+}
+
+
+def test_issue_example_loads_with_defaults_filled_in() -> None:
+    scene = copy.deepcopy(VALID)
+    scene.update(copy.deepcopy(ISSUE_EXAMPLE))
+    loaded = airlight.load_scene(scene)
+    assert loaded["sky"] == {"model": "cie", "type": 12, "zenith_radiance": [1.0, 1.0, 1.0]}
+    assert sorted(loaded["sun"]) == ["direction", "irradiance"]
+    assert loaded["sun"]["direction"] == pytest.approx([0.0, 0.5, -math.sqrt(3) / 2], abs=1e-7)
+    assert loaded["sun"]["irradiance"] == [5.0, 5.0, 5.0]
+    atmosphere = loaded["atmosphere"]
+    assert atmosphere["molecules"] == {"density_scale": 1.0}
+    assert atmosphere["aerosol"] == {"visibility": 5000.0, "scale_height": 1200.0, "g": 0.7, "albedo": 0.9}
+    assert atmosphere["rain"] == {"rate": 10.0, "density_scale": 1.0, "top": 1500.0, "g": 0.87}
+    assert loaded["quality"]["sky_segments"] == 16
+    assert airlight.load_scene(loaded) == loaded
+
+
+def test_daytime_keys_absent_or_null_load_as_null() -> None:
+    loaded = airlight.load_scene(VALID)
+    assert loaded["sky"] is None and loaded["sun"] is None and loaded["atmosphere"] is None
+    scene = copy.deepcopy(VALID)
+    scene.update({"sky": None, "sun": None, "atmosphere": {}})
+    loaded = airlight.load_scene(scene)
+    assert loaded["sky"] is None and loaded["sun"] is None and loaded["atmosphere"] is None
+
+
+@pytest.mark.parametrize("sky_type", range(1, 16))
+def test_only_cie_types_1_3_5_load_without_a_sun(sky_type) -> None:
+    scene = _bad(_set("sky", {"model": "cie", "type": sky_type, "zenith_radiance": 1}))
+    if sky_type in (1, 3, 5):
+        assert airlight.load_scene(scene)["sky"]["type"] == sky_type
+    else:
+        with pytest.raises(ValueError, match='^sky.type:.*"sun"'):
+            airlight.load_scene(scene)
+        scene["sun"] = {"direction": [0, 1, 1]}
+        assert airlight.load_scene(scene)["sun"]["direction"] == pytest.approx([0, 0.5**0.5, 0.5**0.5])
+
+
+_positive = st.floats(1e-6, 1e6)
+_asymmetry = st.floats(-0.999, 0.999)
+
+
+@st.composite
+def _daytime_keys(draw) -> dict[str, Any]:
+    keys: dict[str, Any] = {}
+    model = draw(st.sampled_from([None, "overcast", "cie"]))
+    if model is not None:
+        keys["sky"] = {"model": model, "zenith_radiance": draw(st.lists(_positive, min_size=3, max_size=3))}
+        if model == "cie":
+            keys["sky"]["type"] = draw(st.integers(1, 15))
+    if draw(st.booleans()) or model == "cie":
+        if draw(st.booleans()):
+            keys["sun"] = {"elevation": draw(st.floats(-90.0, 90.0)), "azimuth": draw(st.floats(-1e4, 1e4))}
+        else:
+            direction = draw(st.lists(st.floats(-10.0, 10.0), min_size=3, max_size=3))
+            assume(np.linalg.norm(direction) > 1e-3)
+            keys["sun"] = {"direction": direction}
+        if draw(st.booleans()):
+            keys["sun"]["irradiance"] = draw(_positive)
+    atmosphere: dict[str, Any] = {}
+    if draw(st.booleans()):
+        atmosphere["molecules"] = {"density_scale": draw(st.floats(0.0, 1e6))}
+    if draw(st.booleans()):
+        amount = draw(st.sampled_from(["visibility", "coefficient"]))
+        atmosphere["aerosol"] = {
+            amount: draw(st.floats(1e-3, 1e9) if amount == "visibility" else st.floats(0.0, 1e3)),
+            "scale_height": draw(st.floats(1.0, 1e5)), "g": draw(_asymmetry),
+            "albedo": draw(st.floats(0.0, 1.0))}
+    if draw(st.booleans()):
+        atmosphere["rain"] = {"rate": draw(st.floats(0.0, 1000.0)), "top": draw(st.floats(1.0, 1e5)),
+                              "density_scale": draw(st.floats(0.0, 1e6)), "g": draw(_asymmetry)}
+    if atmosphere or draw(st.booleans()):
+        keys["atmosphere"] = atmosphere
+    keys["quality"] = {"sky_segments": draw(st.integers(2, 64))}
+    return keys
+
+
+@settings(max_examples=200, deadline=None)
+@given(keys=_daytime_keys())
+def test_random_daytime_keys_load_and_round_trip(keys) -> None:
+    """Random valid daytime keys load, the sun's direction is unit, and a loaded scene
+    loads again to itself."""
+    scene = copy.deepcopy(VALID)
+    scene.update(keys)
+    loaded = airlight.load_scene(scene)
+    if loaded["sun"] is not None:
+        assert np.linalg.norm(loaded["sun"]["direction"]) == pytest.approx(1.0, abs=1e-6)
+    assert loaded["quality"]["sky_segments"] == keys["quality"]["sky_segments"]
+    assert airlight.load_scene(loaded) == loaded
