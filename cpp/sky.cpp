@@ -184,6 +184,7 @@ std::vector<float> make_altitude_levels(const shader::SpeciesGpu species[3], int
     const double u_top = std::log1p(y_top / 10.0);
     for (int k = 0; k <= n; ++k) ys[k] = 10.0 * std::expm1(u_top * k / n);
     ys[n] = y_top;
+    std::vector<double> column_part(n + 1, 0.0), mix_part(n + 1, 0.0);
     double sigma0, f0[3];
     shares(0.0, sigma0, f0);
     for (int k = 1; k <= n; ++k) {
@@ -191,10 +192,20 @@ std::vector<float> make_altitude_levels(const shader::SpeciesGpu species[3], int
         shares(ys[k], sigma1, f1);
         double mix = 0.0;
         for (int i = 0; i < 3; ++i) mix += std::abs(f1[i] - f0[i]);
-        v[k] = v[k - 1] + 0.5 * (sigma0 + sigma1) * (ys[k] - ys[k - 1]) / LEVEL_COLUMN_STEP + mix / LEVEL_MIX_STEP;
+        column_part[k] = column_part[k - 1] + 0.5 * (sigma0 + sigma1) * (ys[k] - ys[k - 1]) / LEVEL_COLUMN_STEP;
+        mix_part[k] = mix_part[k - 1] + mix / LEVEL_MIX_STEP;
         sigma0 = sigma1;
         std::copy(f1, f1 + 3, f0);
     }
+    // The two parts share the levels: each gets at least a third of them
+    // whatever the other's total (a dense ground fog's column must not
+    // starve the mixture's change higher up, nor the reverse).
+    const double column_total = column_part[n], mix_total = mix_part[n];
+    const double total = column_total + mix_total;
+    const double column_weight = total > 0.0 ? std::clamp(column_total / total, 1.0 / 3.0, 2.0 / 3.0) : 0.5;
+    for (int k = 0; k <= n; ++k)
+        v[k] = (column_total > 0.0 ? column_weight * column_part[k] / column_total : 0.0) +
+               (mix_total > 0.0 ? (1.0 - column_weight) * mix_part[k] / mix_total : 0.0);
     levels.push_back(0.0f);
     for (int j = 1; j < segments; ++j) {
         const double target = v[n] * j / segments;

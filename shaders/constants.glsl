@@ -60,6 +60,11 @@ CONST int SKY_CIE = 2;
 // The altitude levels that split view rays into scattering volumes: the
 // quality knob's levels plus the profiles' breaks, the ground and the top.
 CONST int ATMOSPHERE_MAX_LEVELS = 80;
+// A volume whose species' shares change fast is cut into at most this many
+// parts (sky.glsl, volume_parts); the walk along a ray is bounded by
+// ATMOSPHERE_MAX_VOLUMES steps, enough for every level crossed cut this finely.
+CONST int VOLUME_MAX_PARTS = 16;
+CONST int ATMOSPHERE_MAX_VOLUMES = (ATMOSPHERE_MAX_LEVELS + 2) * VOLUME_MAX_PARTS;
 // Sky-phase table (cpp/sky_table.cpp, sky.glsl): per kernel k (RGB: the three
 // species' phase functions, A: the clamped cosine of irradiance)
 //   F_k(C, d) = int_{w_y > 0} shape(w) exp(-C / w_y) k(d . w) dw,

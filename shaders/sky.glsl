@@ -236,6 +236,39 @@ int next_altitude_level(float y, float mu) {
     return -1;
 }
 
+// How many equal parts in altitude the volume [y_a, y_b] needs so that the
+// density ratio of any two species that matter there (a share of the
+// extinction above 1e-3 at an end) changes by at most e^{0.5} in each:
+// |y_b - y_a| (max 1/H - min 1/H) / 0.5 over those species, at most
+// VOLUME_MAX_PARTS.
+int volume_parts(float y_a, float y_b) {
+    float y_piece = 0.5f * (y_a + y_b);
+    vec3 at_a = vec3(0.0f);
+    vec3 at_b = vec3(0.0f);
+    vec3 inv_scale = vec3(0.0f);
+    for (int i = 0; i < 3; ++i) {
+        if (!species_present(i)) continue;
+        SpeciesGpu sp = frame.species[i];
+        int k = profile_piece(sp, y_piece);
+        at_a[i] = sp.sigma_t.y * piece_density(sp, k, y_a);
+        at_b[i] = sp.sigma_t.y * piece_density(sp, k, y_b);
+        inv_scale[i] = sp.inv_scales[k];
+    }
+    float sum_a = at_a.x + at_a.y + at_a.z;
+    float sum_b = at_b.x + at_b.y + at_b.z;
+    float lo = 1.0e30f;
+    float hi = -1.0e30f;
+    for (int i = 0; i < 3; ++i) {
+        if (at_a[i] > 1.0e-3f * sum_a || at_b[i] > 1.0e-3f * sum_b) {
+            lo = min(lo, inv_scale[i]);
+            hi = max(hi, inv_scale[i]);
+        }
+    }
+    if (hi <= lo) return 1;
+    float parts = ceil(abs(y_b - y_a) * (hi - lo) / 0.5f);
+    return int(clamp(parts, 1.0f, float(VOLUME_MAX_PARTS)));
+}
+
 // The end (distance s_b, altitude y_b) of the scattering volume that starts
 // at altitude y_a on the ray o + s d (d_y = mu) inside [s_in, s_out]: the next
 // altitude level, or s_out.
@@ -256,10 +289,18 @@ void volume_end(vec3 o, float mu, float s_in, float s_out, float y_a, OUT(float)
 // int_0^dtau e^{-t} S(t) dt for a source S that varies exponentially in
 // optical depth from s_a to s_b (exact when the light reaching the volume is
 // attenuated along one direction, nearly so for the dome): with r = ln(s_b /
-// s_a), s_a dtau expm1(r - dtau) / (r - dtau). Where an end is 0 (a species
-// begins or ends there) S is taken linear instead: s_a (A - B) + s_b B,
-// A = 1 - e^{-dtau}, B = A / dtau - e^{-dtau} (series for small dtau).
+// s_a), s_a dtau expm1(r - dtau) / (r - dtau). (Both ends 0: 0 through the
+// linear form s_a (A - B) + s_b B, A = 1 - e^{-dtau}, B = A / dtau - e^{-dtau}.)
 float source_integral(float dtau, float s_a, float s_b) {
+    // Within a volume every species stays in one profile piece, so an end at
+    // 0 beside a positive one is an underflow (a species or light fading by
+    // more than float32's range), not a species ending: floor it relative to
+    // the other end and keep the exponential form.
+    float floor_value = 1.0e-30f * max(s_a, s_b);
+    if (floor_value > 0.0f) {
+        s_a = max(s_a, floor_value);
+        s_b = max(s_b, floor_value);
+    }
     if (s_a > 0.0f && s_b > 0.0f) {
         float t = min(dtau, 1.0e30f);
         float x = log(s_b / s_a) - t;
@@ -322,10 +363,18 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     float s_a = s_in;
     vec3 weight = exp(-sigma_medium * s_in);  // transmittance from the camera to s_a, medium included
     SpeciesLight light_a = species_light(t, atmosphere_column(y_a), sun_phase);
-    for (int step = 0; step < ATMOSPHERE_MAX_LEVELS + 2 && s_a < s_out; ++step) {
+    for (int step = 0; step < ATMOSPHERE_MAX_VOLUMES && s_a < s_out; ++step) {
         float s_b;
         float y_b;
         volume_end(o, mu, s_in, s_out, y_a, s_b, y_b);
+        // Where the species' density ratios change by more than e^{0.5}
+        // across the volume (a dense, shallow layer far below the camera), it
+        // is cut into equal parts in altitude (docs/daytime.md).
+        int parts = volume_parts(y_a, y_b);
+        if (parts > 1) {
+            y_b = y_a + (y_b - y_a) / float(parts);
+            s_b = s_a + (y_b - y_a) / mu;
+        }
         float len = s_b - s_a;
         float y_piece = 0.5f * (y_a + y_b);
         vec3 tau = stretch_optical_depth(y_a, y_piece, mu, len);
