@@ -27,6 +27,12 @@ struct CpuShader {
     const float* phase_glow_texels[2];
     const float* sky_texels;  // RGBA, width SKY_TABLE columns (null when unused)
     int sky_table_width;
+    const float* rainbow_texels;  // RGBA, RAINBOW_TABLE_N texels (null when unused)
+
+    vec4 rainbow_table_texel(int x) const {
+        const float* t = rainbow_texels + size_t(x) * 4;
+        return vec4(t[0], t[1], t[2], t[3]);
+    }
 
     vec4 sky_table_texel(int x, int y) const {
         const float* t = sky_texels + (size_t(y) * size_t(sky_table_width) + size_t(x)) * 4;
@@ -68,6 +74,7 @@ struct CpuShader {
 #define HAS_SUN (features.sun)
 #define HAS_ATMOSPHERE (features.atmosphere)
 #define SKY_MARCH (features.sky_march)
+#define HAS_RAINBOW (features.rainbow)
 // The same order as the GLSL source (gl_backend.cpp).
 // clang-format off
 #include "geometry.glsl"
@@ -90,6 +97,7 @@ struct CpuShader {
 #undef HAS_SUN
 #undef HAS_ATMOSPHERE
 #undef SKY_MARCH
+#undef HAS_RAINBOW
 };
 
 }  // namespace shader
@@ -117,7 +125,8 @@ void CpuBackend::render(const FrameData& data, Image& out) {
                                     {texels_of(data.phase_moments[0]), texels_of(data.phase_moments[1])},
                                     {texels_of(data.phase_glow[0]), texels_of(data.phase_glow[1])},
                                     texels_of(data.sky_table),
-                                    data.sky_table ? data.sky_table->width : 0};
+                                    data.sky_table ? data.sky_table->width : 0,
+                                    texels_of(data.rainbow_table)};
     std::atomic<int> next_row{0};
     auto worker = [&]() {
         shader::CpuShader local = program;

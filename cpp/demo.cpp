@@ -32,7 +32,9 @@ const char* kUsage =
     "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
     "  the headlight experiment (a car approaching from --from to --to metres,\n"
     "  the camera tracking it; frames DIR/frame_NN_DDDDm.png):\n"
-    "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n";
+    "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n"
+    "  the end of a rain (a rainbow appearing and fading; needs atmosphere.rain and a sun):\n"
+    "                     --sequence rain-ends --out DIR [--frames N]\n";
 
 struct Options {
     std::string scene, out, backend = "auto", sequence;
@@ -121,7 +123,8 @@ Options parse_args(int argc, char** argv) {
             if (o.pupil != "auto") parse_number(arg, value, 1.0, 9.0, "'auto' or a diameter in [1, 9] mm");
         } else if (arg == "--sequence") {
             o.sequence = value;
-            if (o.sequence != "approaching-car") fail("--sequence must be approaching-car, got '" + o.sequence + "'");
+            if (o.sequence != "approaching-car" && o.sequence != "rain-ends")
+                fail("--sequence must be approaching-car or rain-ends, got '" + o.sequence + "'");
         } else if (arg == "--frames")
             o.frames = parse_int(arg, value, 2, 1000);
         else if (arg == "--from")
@@ -136,7 +139,7 @@ Options parse_args(int argc, char** argv) {
     if (o.backend != "auto" && o.backend != "gl" && o.backend != "cpu") {
         fail("--backend must be auto, gl or cpu, got '" + o.backend + "'");
     }
-    if (!o.sequence.empty() && !(o.to < o.from)) fail("--to must be less than --from");
+    if (o.sequence == "approaching-car" && !(o.to < o.from)) fail("--to must be less than --from");
     return o;
 }
 
@@ -227,6 +230,48 @@ int run_sequence(airlight::Scene scene, const Options& o, airlight::Backend back
     return 0;
 }
 
+// The end of a rain (MODELS.md section 4): over the frames the clouds part
+// (the sun's irradiance rises from 0 to the scene's along a smoothstep over the
+// first 40 % of the sequence) while the drops fall out (the rain's
+// density_scale decays from the scene's value by a factor 100, evenly in
+// log): the bow appears as the sun comes out and fades with the drops. The
+// rainbow table depends on the rate only, so it is built once.
+int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend backend) {
+    using namespace airlight;
+    if (!scene.atmosphere.rain.present || !(scene.atmosphere.rain.rate > 0.0f))
+        fail("--sequence rain-ends: the scene needs atmosphere.rain with a rate > 0");
+    if (!scene.sun.present) fail("--sequence rain-ends: the scene needs a sun");
+    DisplaySettings settings = display_settings(scene, o);
+    std::error_code error;
+    std::filesystem::create_directories(o.out, error);
+    if (error) fail("--out: cannot create directory '" + o.out + "': " + error.message());
+    Renderer renderer(backend);
+    // One exposure for the whole sequence (automatic: the full scene's), so
+    // that the brightening and the fading show.
+    if (settings.exposure_mode == ExposureMode::automatic) {
+        settings.exposure = resolve_exposure(renderer.render(scene), settings);
+        settings.exposure_mode = ExposureMode::manual;
+    }
+    const float density0 = scene.atmosphere.rain.density_scale;
+    for (int k = 0; k < o.frames; ++k) {
+        const double t = double(k) / double(o.frames - 1);
+        const double s = std::min(1.0, t / 0.4);
+        Scene frame = scene;
+        frame.sun.irradiance = scene.sun.irradiance * float(s * s * (3.0 - 2.0 * s));
+        frame.atmosphere.rain.density_scale = float(density0 * std::pow(1e-2, t));
+        const auto start = std::chrono::steady_clock::now();
+        const Image image = renderer.render(frame);
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
+        char name[80];
+        std::snprintf(name, sizeof name, "/frame_%02d_density_%.4f.png", k, double(frame.atmosphere.rain.density_scale));
+        const std::string path = o.out + name;
+        write_png(path, shown.width, shown.height, shown.srgb8);
+        print_report(path, image, backend, ms, &shown.report);
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -255,7 +300,8 @@ int main(int argc, char** argv) {
             std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
     }
     try {
-        if (!o.sequence.empty()) return run_sequence(scene, o, backend);
+        if (o.sequence == "approaching-car") return run_sequence(scene, o, backend);
+        if (o.sequence == "rain-ends") return run_rain_ends(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
             return run_window(scene, backend, display_settings(scene, o));

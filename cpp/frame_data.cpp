@@ -6,6 +6,7 @@
 #include <glm/gtx/component_wise.hpp>
 #include <limits>
 
+#include "rainbow.hpp"
 #include "sky.hpp"
 
 namespace airlight {
@@ -108,6 +109,12 @@ void add_daytime(const Scene& scene, FrameData& data) {
     const bool columns = data.features.sky && data.features.atmosphere;
     if (columns || (data.features.sky && data.features.surfaces))
         data.sky_table = &sky_phase_table(f.sky, f.species, columns);
+    // Rainbows (MODELS.md section 4): the rain's phase for sunlight from the Mie
+    // table; a scene without sun or without drops builds none.
+    const Rain& rain = scene.atmosphere.rain;
+    data.features.rainbow = data.features.sun && f.species[2].phase.z != 0.0f && rain.phase == RainPhase::mie;
+    if (data.features.rainbow)
+        data.rainbow_table = &rainbow_phase_table(double(rain.rate), scene.quality.rainbow_wavelengths);
     f.atmosphere = glm::vec4(top, float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS))),
                              data.sky_table ? float(data.sky_table->width) : 1.0f,
                              data.sky_table ? float(data.sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f);

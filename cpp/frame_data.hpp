@@ -28,6 +28,9 @@ struct FrameData {
     // an atmosphere (then with its columns) or surfaces (C = 0 only when
     // there is no atmosphere).
     const Table2D* sky_table = nullptr;
+    // The rainbow table (cpp/rainbow.hpp): only for rain lit by the sun with
+    // the "mie" phase.
+    const Table2D* rainbow_table = nullptr;
 };
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and

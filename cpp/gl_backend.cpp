@@ -262,6 +262,7 @@ std::string fragment_shader_source(const shader::Features& features) {
     source += std::string("#define HAS_SUN ") + (features.sun ? "true" : "false") + "\n";
     source += std::string("#define HAS_ATMOSPHERE ") + (features.atmosphere ? "true" : "false") + "\n";
     source += std::string("#define SKY_MARCH ") + (features.sky_march ? "true" : "false") + "\n";
+    source += std::string("#define HAS_RAINBOW ") + (features.rainbow ? "true" : "false") + "\n";
     for (const char* name :
          {"constants.glsl", "layout.glsl", "phase_math.glsl", "sky_math.glsl", "resources.glsl", "geometry.glsl",
           "airlight.glsl", "phase.glsl", "spot.glsl", "sky.glsl", "shading.glsl", "render.frag"}) {
@@ -703,6 +704,7 @@ void GlBackend::render(const FrameData& data, Image& out) {
         if (data.phase_glow[lobe]) glBindTextureUnit(5 + lobe, s.texture_for(*data.phase_glow[lobe]));
     }
     if (data.sky_table) glBindTextureUnit(7, s.texture_for(*data.sky_table));
+    if (data.rainbow_table) glBindTextureUnit(8, s.texture_for(*data.rainbow_table));
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glDisable(GL_DEPTH_TEST);

@@ -51,24 +51,42 @@ MieEfficiencies mie_efficiencies(const MieCoefficients& c) {
 
 void mie_amplitudes(const MieCoefficients& c, const std::vector<double>& theta, std::vector<std::complex<double>>& s1,
                     std::vector<std::complex<double>>& s2) {
-    s1.assign(theta.size(), 0.0);
-    s2.assign(theta.size(), 0.0);
-    for (size_t k = 0; k < theta.size(); ++k) {
-        const double mu = std::cos(theta[k]);
-        double pi_prev = 0.0, pi_n = 1.0;  // pi_0, pi_1 (BH 4.47)
-        std::complex<double> sum1 = 0.0, sum2 = 0.0;
-        for (size_t i = 0; i < c.a.size(); ++i) {
-            const double n = double(i + 1);
-            const double tau_n = n * mu * pi_n - (n + 1.0) * pi_prev;
-            const double f = (2.0 * n + 1.0) / (n * (n + 1.0));
-            sum1 += f * (c.a[i] * pi_n + c.b[i] * tau_n);  // BH 4.74
-            sum2 += f * (c.a[i] * tau_n + c.b[i] * pi_n);
-            const double pi_next = ((2.0 * n + 1.0) * mu * pi_n - (n + 1.0) * pi_prev) / n;
-            pi_prev = pi_n;
-            pi_n = pi_next;
+    // The angular functions pi_n, tau_n (BH 4.46-4.47) by upward recurrence, with
+    // the terms outermost and the angles innermost so that the angle loop runs
+    // over plain arrays (vectorised); this is where a rainbow table spends its time.
+    const size_t count = theta.size();
+    std::vector<double> mu(count), pi_prev(count, 0.0), pi_n(count, 1.0);
+    std::vector<double> s1_re(count, 0.0), s1_im(count, 0.0), s2_re(count, 0.0), s2_im(count, 0.0);
+    for (size_t k = 0; k < count; ++k) mu[k] = std::cos(theta[k]);
+    for (size_t i = 0; i < c.a.size(); ++i) {
+        const double n = double(i + 1);
+        const double f = (2.0 * n + 1.0) / (n * (n + 1.0));
+        const double ar = f * c.a[i].real(), ai = f * c.a[i].imag();
+        const double br = f * c.b[i].real(), bi = f * c.b[i].imag();
+        const double up = (2.0 * n + 1.0) / n, down = (n + 1.0) / n;
+        double* __restrict p = pi_n.data();
+        double* __restrict q = pi_prev.data();
+        const double* __restrict m = mu.data();
+        double* __restrict x1 = s1_re.data();
+        double* __restrict y1 = s1_im.data();
+        double* __restrict x2 = s2_re.data();
+        double* __restrict y2 = s2_im.data();
+        for (size_t k = 0; k < count; ++k) {
+            const double pik = p[k];
+            const double tau = n * m[k] * pik - (n + 1.0) * q[k];
+            x1[k] += ar * pik + br * tau;  // BH 4.74
+            y1[k] += ai * pik + bi * tau;
+            x2[k] += ar * tau + br * pik;
+            y2[k] += ai * tau + bi * pik;
+            p[k] = up * m[k] * pik - down * q[k];
+            q[k] = pik;
         }
-        s1[k] = sum1;
-        s2[k] = sum2;
+    }
+    s1.resize(count);
+    s2.resize(count);
+    for (size_t k = 0; k < count; ++k) {
+        s1[k] = {s1_re[k], s1_im[k]};
+        s2[k] = {s2_re[k], s2_im[k]};
     }
 }
 

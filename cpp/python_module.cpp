@@ -17,6 +17,7 @@
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
 #include "scene_json.hpp"
+#include "rainbow.hpp"
 #include "tables.hpp"
 
 namespace py = pybind11;
@@ -259,6 +260,77 @@ PYBIND11_MODULE(_core, m) {
         }
         return out;
     });
+    // Rainbow tables (cpp/rainbow.hpp): exposed for tests and benchmarks.
+    m.def(
+        "rainbow_phase_table",
+        [](double rate, int wavelengths) {
+            if (!(rate > 0.0) || !std::isfinite(rate)) throw py::value_error("rate: must be a positive number (mm/h)");
+            if (wavelengths != 3 && wavelengths != 5 && wavelengths != 9 && wavelengths != 17)
+                throw py::value_error("wavelengths: must be 3, 5, 9 or 17");
+            const airlight::Table2D& t = airlight::rainbow_phase_table(rate, wavelengths);
+            py::array_t<float> out({t.width, 4});
+            std::memcpy(out.mutable_data(), t.texels.data(), t.texels.size() * sizeof(float));
+            return out;
+        },
+        py::arg("rate"), py::arg("wavelengths"));
+    m.def(
+        "rainbow_spectral_table",
+        [](int samples, unsigned long long seed, const std::vector<int>& wavelengths) {
+            // samples 0: the embedded table; else a new one (Monte Carlo, as
+            // build/cpp/make_rainbow_table computes it) for the given nodes.
+            airlight::RainbowSpectralTable computed;
+            if (samples != 0) {
+                if (samples < 64 || samples > 1 << 20) throw py::value_error("samples: must be in [64, 1048576]");
+                for (int w : wavelengths)
+                    if (w < 0 || w >= airlight::RAINBOW_WAVELENGTHS)
+                        throw py::value_error("wavelengths: node indices are 0.." +
+                                              std::to_string(airlight::RAINBOW_WAVELENGTHS - 1));
+                airlight::RainbowSampling s;
+                s.samples_per_wavelength = samples;
+                s.seed = seed;
+                s.wavelengths = wavelengths;
+                py::gil_scoped_release release;
+                computed = airlight::compute_rainbow_spectral_table(s);
+            }
+            const airlight::RainbowSpectralTable& t = samples != 0 ? computed : airlight::rainbow_spectral_table();
+        const py::ssize_t nr = py::ssize_t(t.rates.size()), nw = py::ssize_t(t.wavelengths_nm.size()),
+                          na = py::ssize_t(t.angles_deg.size());
+        py::array_t<float> phase({nr, nw, na}), rel_error({nr, nw, na});
+        std::memcpy(phase.mutable_data(), t.phase.data(), t.phase.size() * sizeof(float));
+        std::memcpy(rel_error.mutable_data(), t.rel_error.data(), t.rel_error.size() * sizeof(float));
+        py::dict d;
+        d["wavelengths_nm"] = py::array_t<double>(py::ssize_t(nw), t.wavelengths_nm.data());
+        d["rates"] = py::array_t<double>(py::ssize_t(nr), t.rates.data());
+        d["angles_deg"] = py::array_t<double>(py::ssize_t(na), t.angles_deg.data());
+        d["phase"] = phase;
+        d["rel_error"] = rel_error;
+        d["samples_per_wavelength"] = t.samples_per_wavelength;
+        return d;
+        },
+        py::arg("samples") = 0, py::arg("seed") = 1, py::arg("wavelengths") = std::vector<int>{});
+    m.def("rainbow_rgb_weights", [](int count) {
+        if (count != 3 && count != 5 && count != 9 && count != 17)
+            throw py::value_error("count: must be 3, 5, 9 or 17");
+        const std::vector<float> w = airlight::rainbow_rgb_weights(count);
+        py::array_t<float> out({py::ssize_t(count), py::ssize_t(3)});
+        std::memcpy(out.mutable_data(), w.data(), w.size() * sizeof(float));
+        return out;
+    });
+    m.def("water_refractive_index", &airlight::water_refractive_index, py::arg("wavelength_nm"));
+    m.def(
+        "mie_sun_disc_phase",
+        [](double refractive_index, double diameter_mm, double wavelength_nm, const std::vector<double>& angles_deg,
+           int n_radial) {
+            if (!(diameter_mm > 0.0 && diameter_mm <= 10.0)) throw py::value_error("diameter_mm: must be in (0, 10]");
+            if (!(wavelength_nm >= 200.0 && wavelength_nm <= 2000.0))
+                throw py::value_error("wavelength_nm: must be in [200, 2000]");
+            if (n_radial < 1 || n_radial > 64) throw py::value_error("n_radial: must be in [1, 64]");
+            const std::vector<double> p =
+                airlight::mie_sun_disc_phase(refractive_index, diameter_mm, wavelength_nm, angles_deg, n_radial);
+            return py::array_t<double>(py::ssize_t(p.size()), p.data());
+        },
+        py::arg("refractive_index"), py::arg("diameter_mm"), py::arg("wavelength_nm"), py::arg("angles_deg"),
+        py::arg("n_radial") = 12);
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

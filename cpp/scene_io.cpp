@@ -47,6 +47,7 @@ const NameTable<ToneCurve> tone_curves{{"linear", ToneCurve::linear},
                                        {"loglog", ToneCurve::loglog},
                                        {"reinhard", ToneCurve::reinhard},
                                        {"filmic", ToneCurve::filmic}};
+const NameTable<RainPhase> rain_phases{{"mie", RainPhase::mie}, {"hg", RainPhase::hg}};
 const NameTable<SkyModel> sky_models{{"overcast", SkyModel::overcast}, {"cie", SkyModel::cie}};
 const NameTable<SurfaceType> surface_types{
     {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
@@ -457,7 +458,8 @@ double json_number(float f) {
 json json_vec3(const glm::vec3& v) { return json::array({json_number(v.x), json_number(v.y), json_number(v.z)}); }
 
 Quality parse_quality(const Obj& o) {
-    o.check_keys({"airlight", "march_steps", "cull_fraction", "spot_glow_samples", "sky_segments"});
+    o.check_keys(
+        {"airlight", "march_steps", "cull_fraction", "spot_glow_samples", "sky_segments", "rainbow_wavelengths"});
     Quality q;
     if (auto v = o.opt("airlight")) q.airlight = read_enum(*v, "airlight", airlight_methods);
     if (auto v = o.opt("march_steps")) q.march_steps = read_int(*v, 1, 65536);
@@ -471,6 +473,13 @@ Quality parse_quality(const Obj& o) {
         if (q.spot_glow_samples % 4 != 0) fail(Kind::value, v->field, "must be a multiple of 4");
     }
     if (auto v = o.opt("sky_segments")) q.sky_segments = read_int(*v, 2, 64);
+    if (auto v = o.opt("rainbow_wavelengths")) {
+        q.rainbow_wavelengths = read_int(*v, 3, 17);
+        if (q.rainbow_wavelengths != 3 && q.rainbow_wavelengths != 5 && q.rainbow_wavelengths != 9 &&
+            q.rainbow_wavelengths != 17)
+            fail(Kind::value, v->field, "must be 3, 5, 9 or 17 (wavelength nodes), got " +
+                                          std::to_string(q.rainbow_wavelengths));
+    }
     return q;
 }
 
@@ -565,12 +574,13 @@ Atmosphere parse_atmosphere(const Obj& o) {
     }
     if (auto v = o.opt("rain"); v && !v->j.is_null()) {
         Obj m(*v);
-        m.check_keys({"rate", "density_scale", "top", "g"});
+        m.check_keys({"rate", "density_scale", "top", "g", "phase"});
         a.rain.present = true;
         a.rain.rate = read_in_range(m.req("rate"), 0.0, 1000.0, " mm/h");
         if (auto d = m.opt("density_scale")) a.rain.density_scale = read_in_range(*d, 0.0, 1e6);
         if (auto d = m.opt("top")) a.rain.top = read_positive(*d, 1e5, true);
         if (auto d = m.opt("g")) a.rain.g = read_asymmetry(*d);
+        if (auto d = m.opt("phase")) a.rain.phase = read_enum(*d, "rain phase", rain_phases);
     }
     return a;
 }
@@ -605,7 +615,8 @@ json atmosphere_to_json(const Atmosphere& a) {
         j["rain"] = {{"rate", json_number(a.rain.rate)},
                      {"density_scale", json_number(a.rain.density_scale)},
                      {"top", json_number(a.rain.top)},
-                     {"g", json_number(a.rain.g)}};
+                     {"g", json_number(a.rain.g)},
+                     {"phase", name_of(rain_phases, a.rain.phase)}};
     return j;
 }
 
@@ -776,7 +787,8 @@ json scene_to_json_value(const Scene& s) {
                     {"march_steps", s.quality.march_steps},
                     {"cull_fraction", json_number(s.quality.cull_fraction)},
                     {"spot_glow_samples", s.quality.spot_glow_samples},
-                    {"sky_segments", s.quality.sky_segments}};
+                    {"sky_segments", s.quality.sky_segments},
+                    {"rainbow_wavelengths", s.quality.rainbow_wavelengths}};
     j["sky"] = sky_to_json(s.sky);
     j["sun"] = sun_to_json(s.sun);
     j["atmosphere"] = atmosphere_to_json(s.atmosphere);

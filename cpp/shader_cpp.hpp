@@ -40,12 +40,13 @@ struct Features {
     bool sun = false;             // a sun above the horizon with some irradiance
     bool atmosphere = false;      // a height-varying atmosphere: scattering volumes along view rays
     bool sky_march = false;       // brute-force marching of the atmosphere instead (benchmarks)
+    bool rainbow = false;         // rain lit by the sun scatters with the Mie table (rainbows)
 
     int key() const {
         return (medium ? 1 : 0) | (point_lights ? 2 : 0) | (surfaces ? 4 : 0) | (airlight ? 8 : 0) |
                (airlight_march ? 16 : 0) | (grey_medium ? 32 : 0) | (spot_lights ? 64 : 0) | (spot_airlight ? 128 : 0) |
                (phase ? 256 : 0) | (sky ? 512 : 0) | (sun ? 1024 : 0) | (atmosphere ? 2048 : 0) |
-               (sky_march ? 4096 : 0);
+               (sky_march ? 4096 : 0) | (rainbow ? 8192 : 0);
     }
 };
 

@@ -78,3 +78,9 @@ CONST int SKY_TABLE_N_AZIMUTH = 32;
 CONST float SKY_TABLE_C0 = 0.01f;
 CONST float SKY_TABLE_C_MAX = 100.0f;
 CONST float SKY_TABLE_FLOOR = 1.0e-12f;
+
+// Rainbow table (cpp/rainbow.hpp, sky.glsl): the raindrops' linear-sRGB phase
+// function seen through the sun's disc, at scattering angles a * 180 / (N - 1)
+// degrees: 0.05 degree, the spectral table's finest step (its bows are smooth
+// on that scale after the 0.53-degree disc; docs/rainbow.md).
+CONST int RAINBOW_TABLE_N = 3601;

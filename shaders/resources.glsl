@@ -29,6 +29,12 @@ vec4 sky_table_texel(int x, int y) {
     return texelFetch(sky_texels, ivec2(x, y), 0);
 }
 
+layout(binding = 8) uniform sampler2D rainbow_texels;  // the rainbow table (sky.glsl)
+
+vec4 rainbow_table_texel(int x) {
+    return texelFetch(rainbow_texels, ivec2(x, 0), 0);
+}
+
 float table_texel(int table, int x, int y) {
     if (table == TABLE_AIRLIGHT_TAIL) return texelFetch(airlight_tail_texels, ivec2(x, y), 0).r;
     if (table == TABLE_PHASE_GLOW_0) return texelFetch(phase_glow_texels0, ivec2(x, y), 0).r;

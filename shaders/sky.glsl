@@ -144,7 +144,31 @@ struct SpeciesLight {
     vec3 sun[3];
 };
 
-SpeciesLight species_light(SkyTableDirection t, vec3 column, vec3 sun_phase) {
+// Each species' phase function for the sun's light along a view ray, per
+// channel (only the rain's depends on wavelength: its rainbow).
+struct SunPhase {
+    vec3 species[3];
+};
+
+// The rain's phase for sunlight at scattering angle acos(cos_theta) from the
+// rainbow table (MODELS.md section 4; cpp/rainbow.hpp): linear in angle
+// between texels 0.05 degree apart.
+vec3 rainbow_phase(float cos_theta) {
+    float x = precise_acos(cos_theta) * (float(RAINBOW_TABLE_N - 1) / PI);
+    int i = min(int(x), RAINBOW_TABLE_N - 2);
+    float f = clamp(x - float(i), 0.0f, 1.0f);
+    return mix(vec3(rainbow_table_texel(i)), vec3(rainbow_table_texel(i + 1)), f);
+}
+
+SunPhase sun_phase_along(vec3 d) {
+    SunPhase p;
+    float cos_sun = dot(d, vec3(frame.sky.sun_direction));
+    for (int i = 0; i < 3; ++i) p.species[i] = vec3(species_phase(frame.species[i].phase, cos_sun));
+    if (HAS_RAINBOW) p.species[2] = rainbow_phase(cos_sun);
+    return p;
+}
+
+SpeciesLight species_light(SkyTableDirection t, vec3 column, SunPhase sun_phase) {
     SpeciesLight out_light;
     vec4 k0 = vec4(0.0f);
     vec4 k1 = vec4(0.0f);
@@ -160,9 +184,9 @@ SpeciesLight species_light(SkyTableDirection t, vec3 column, vec3 sun_phase) {
     out_light.sky[0] = lz * vec3(k0.x, k1.x, k2.x);
     out_light.sky[1] = lz * vec3(k0.y, k1.y, k2.y);
     out_light.sky[2] = lz * vec3(k0.z, k1.z, k2.z);
-    out_light.sun[0] = sun * sun_phase.x;
-    out_light.sun[1] = sun * sun_phase.y;
-    out_light.sun[2] = sun * sun_phase.z;
+    out_light.sun[0] = sun * sun_phase.species[0];
+    out_light.sun[1] = sun * sun_phase.species[1];
+    out_light.sun[2] = sun * sun_phase.species[2];
     return out_light;
 }
 
@@ -352,11 +376,9 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
     SkyTableDirection t = sky_table_direction(d);
-    vec3 sun_phase = vec3(0.0f);
-    if (HAS_SUN) {
-        float cos_sun = dot(d, vec3(frame.sky.sun_direction));
-        for (int i = 0; i < 3; ++i) sun_phase[i] = species_phase(frame.species[i].phase, cos_sun);
-    }
+    SunPhase sun_phase;
+    for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
+    if (HAS_SUN) sun_phase = sun_phase_along(d);
     float mu = d.y;
     float y_a = o.y + mu * s_in;
     if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.x);
@@ -460,11 +482,9 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
     float s_far = march_far_distance(o, d, s_in, s_out, sigma_medium);
     SkyTableDirection t = sky_table_direction(d);
-    vec3 sun_phase = vec3(0.0f);
-    if (HAS_SUN) {
-        float cos_sun = dot(d, vec3(frame.sky.sun_direction));
-        for (int i = 0; i < 3; ++i) sun_phase[i] = species_phase(frame.species[i].phase, cos_sun);
-    }
+    SunPhase sun_phase;
+    for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
+    if (HAS_SUN) sun_phase = sun_phase_along(d);
     float ds = (s_far - s_in) / float(steps);
     vec3 tau_medium = sigma_medium * s_in;
     vec3 tau = vec3(0.0f);  // the atmosphere's, from s_in (summed, not multiplied: no drift in float32)

@@ -149,12 +149,19 @@ struct Aerosol {
 // extinction is pi N0 / Lambda^3 (extinction efficiency 2) times
 // density_scale; constant density from the ground to `top` (the cloud base,
 // m); Henyey-Greenstein g of large drops.
+// How rain scatters the sun (MODELS.md section 4): "mie", the drops'
+// Lorenz-Mie phase function averaged over the rate's drop sizes, per
+// wavelength (rainbows; cpp/rainbow.hpp); or "hg", Henyey-Greenstein with g.
+// Sky light is always scattered with HG g (the sky is smooth; docs/rainbow.md).
+enum class RainPhase { mie, hg };
+
 struct Rain {
     bool present = false;
     float rate = 0.0f;
-    float density_scale = 1.0f;
+    float density_scale = 1.0f;  // drop density relative to the rate's (the fading rain of a rainbow)
     float top = 1500.0f;
     float g = 0.87f;
+    RainPhase phase = RainPhase::mie;
 };
 
 struct Atmosphere {
@@ -186,6 +193,9 @@ struct Quality {
     // the number of altitude levels that split view rays through the
     // atmosphere (docs/daytime.md measures error against it), in [2, 64].
     int sky_segments = 16;
+    // Wavelength nodes (3, 5, 9 or 17, 380-720 nm) of the rainbow's spectral
+    // phase function turned into RGB (docs/rainbow.md measures the colour error).
+    int rainbow_wavelengths = 17;
 };
 
 struct Scene {

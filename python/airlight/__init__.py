@@ -47,6 +47,7 @@ __all__ = [
     "load_scene",
     "preset",
     "preset_names",
+    "rainbow_phase",
     "render",
     "save_pfm",
     "save_png",
@@ -420,6 +421,29 @@ def table_stats() -> dict[str, dict[str, Any]]:
     the species' phase functions change: ``builds`` counts its builds, the other
     fields describe the last one."""
     return dict(_core.tables_built())
+
+
+def rainbow_phase(rate: float, angles_deg: Any = None, *, wavelengths: int = 17) -> np.ndarray:
+    """The raindrops' phase function for sunlight that the renderer uses (rain with
+    ``"phase": "mie"``; MODELS.md section 4, docs/rainbow.md): Lorenz-Mie, averaged over
+    the Marshall-Palmer drop sizes of ``rate`` (mm/h), seen through the sun's
+    0.53-degree disc, converted from ``wavelengths`` spectral nodes (3, 5, 9 or 17) to
+    linear sRGB (CIE 1931, D65). Returns float32 (n, 3) in sr^-1 at ``angles_deg``
+    (scattering angles, 0 = forward; default: the table's own 0.05-degree grid),
+    interpolated linearly in angle as the shaders do."""
+    r = _real("rate", rate)
+    if r <= 0.0:
+        raise ValueError(f"rate: must be positive (mm/h), got {rate!r}")
+    if isinstance(wavelengths, bool) or not isinstance(wavelengths, numbers.Integral):
+        raise TypeError(f"wavelengths: expected an integer, got {type(wavelengths).__name__}")
+    table = _core.rainbow_phase_table(r, int(wavelengths))[:, :3]
+    grid = np.linspace(0.0, 180.0, table.shape[0])
+    if angles_deg is None:
+        return table.copy()
+    a = np.asarray(angles_deg, dtype=np.float64)
+    if a.ndim != 1 or not np.all(np.isfinite(a)) or np.any((a < 0.0) | (a > 180.0)):
+        raise ValueError("angles_deg: must be a 1-D array of angles in [0, 180] degrees")
+    return np.stack([np.interp(a, grid, table[:, c]) for c in range(3)], axis=1).astype(np.float32)
 
 
 def _real(name: str, value: Any) -> float:

@@ -353,6 +353,9 @@ class Species:
     albedo: float
     phase: object  # "rayleigh" or HG g
     profile: Profile
+    # For sunlight only: a callable cos(theta) -> (3,) per-channel phase (the rain's
+    # rainbow table), else ``phase``.
+    sun_phase: object = None
 
     @property
     def sigma_s0(self) -> np.ndarray:
@@ -408,7 +411,8 @@ class Atmosphere:
 def make_atmosphere(rain_rate: float = 0.0, visibility: float | None = None, molecules: bool = True,
                     aerosol_g: float = AEROSOL_G, aerosol_albedo: float = AEROSOL_ALBEDO,
                     aerosol_scale_height: float = AEROSOL_SCALE_HEIGHT, rain_top: float = RAIN_TOP,
-                    rain_g: float = RAIN_G, top: float = math.inf) -> Atmosphere:
+                    rain_g: float = RAIN_G, top: float = math.inf, rain_density_scale: float = 1.0,
+                    rain_sun_phase=None) -> Atmosphere:
     """The weather state. ``visibility`` (m): Koschmieder at ground level, green channel, of the
     clear air (molecules + aerosol): aerosol sigma_t(0) = 3.912 / V - Rayleigh_G(0), at least 0,
     grey (the same in R, G, B). None: no aerosol. ``top``: the medium ends there (the dome)."""
@@ -423,8 +427,8 @@ def make_atmosphere(rain_rate: float = 0.0, visibility: float | None = None, mol
             species.append(Species("aerosol", np.full(3, ext), aerosol_albedo, aerosol_g,
                                    _truncate(aerosol_profile(aerosol_scale_height), top)))
     if rain_rate > 0.0:
-        species.append(Species("rain", np.full(3, rain_extinction(rain_rate)), RAIN_ALBEDO, rain_g,
-                               _truncate(rain_profile(rain_top), top)))
+        species.append(Species("rain", np.full(3, rain_extinction(rain_rate) * rain_density_scale), RAIN_ALBEDO,
+                               rain_g, _truncate(rain_profile(rain_top), top), rain_sun_phase))
     return Atmosphere(tuple(species))
 
 
@@ -601,7 +605,10 @@ class InScatter:
             self._vals = vals
         if sky.sun_visible:
             s = sky.sun
-            self.sun_phase = np.array([phase(p, float(self.view @ s)) for p in self.phases])
+            cos_sun = float(self.view @ s)
+            self.sun_phase = np.stack(  # (3 channels, n_species)
+                [np.asarray(sp.sun_phase(cos_sun), dtype=float) if sp.sun_phase is not None
+                 else np.full(3, phase(sp.phase, cos_sun)) for sp in atm.species], axis=-1)
         else:
             self.sun_phase = None
 

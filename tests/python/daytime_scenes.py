@@ -6,6 +6,7 @@ from __future__ import annotations
 
 import math
 
+import airlight
 import daytime_reference as ref
 import numpy as np
 import reference
@@ -38,7 +39,7 @@ def atmosphere(molecules: bool = True, visibility: float | None = None, rain: fl
     if visibility is not None:
         out["aerosol"] = {"visibility": visibility, "scale_height": scale_height, "g": 0.7, "albedo": 0.9}
     if rain > 0.0:
-        out["rain"] = {"rate": rain}
+        out["rain"] = {"rate": rain, "phase": "hg"}
     return out
 
 
@@ -91,7 +92,22 @@ def reference_atmosphere(scene: dict) -> ref.Atmosphere:
         aerosol_scale_height=aerosol.get("scale_height", ref.AEROSOL_SCALE_HEIGHT) if aerosol
         else ref.AEROSOL_SCALE_HEIGHT,
         rain_top=rain.get("top", ref.RAIN_TOP) if rain else ref.RAIN_TOP,
-        rain_g=rain.get("g", ref.RAIN_G) if rain else ref.RAIN_G)
+        rain_g=rain.get("g", ref.RAIN_G) if rain else ref.RAIN_G,
+        rain_density_scale=rain.get("density_scale", 1.0) if rain else 1.0,
+        rain_sun_phase=_rainbow_sun_phase(scene) if rain and rain.get("phase", "mie") == "mie" else None)
+
+
+def _rainbow_sun_phase(scene: dict):
+    """The rain's phase for sunlight that a "mie" rain uses: the library's rainbow table (an
+    input of the reference, like the scene; its accuracy is tested in test_rainbow.py)."""
+    rain = scene["atmosphere"]["rain"]
+    n = (scene.get("quality") or {}).get("rainbow_wavelengths", 17)
+
+    def sun_phase(cos_theta: float) -> np.ndarray:
+        angle = math.degrees(math.acos(max(-1.0, min(1.0, cos_theta))))
+        return airlight.rainbow_phase(rain["rate"], [angle], wavelengths=n)[0].astype(float)
+
+    return sun_phase
 
 
 def scene_directions(scene: dict) -> np.ndarray:

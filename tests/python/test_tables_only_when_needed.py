@@ -147,3 +147,32 @@ def test_sky_table_is_rebuilt_only_when_the_sky_or_the_phases_change():
     result = run(rain + [clear, other_g, rain[0]])
     assert result["stats"]["sky_phase"]["builds"] == 3  # the rains (also the last frame): one; clear; other g
     assert result["stats"]["sky_phase"]["height"] == 64  # the last built: azimuth-free
+
+
+# ---- Rainbows (issue 7): the rainbow table ------------------------------------------------------
+SUN = {"elevation": 20, "azimuth": 180, "irradiance": [20, 20, 20]}
+
+
+def test_rainbow_table_only_for_rain_lit_by_the_sun():
+    """A scene without sun or without drops builds no Mie table: rain under an overcast sky,
+    a sun over haze without rain, rain with "phase": "hg", and rain whose drops have gone
+    (density_scale 0) build none; rain lit by the sun builds one (3601 RGBA texels)."""
+    rain = {"rain": {"rate": 25, "density_scale": 0.3}}
+    assert "rainbow_phase" not in run([base(sky=OVERCAST, atmosphere=rain)])["seen"][0]
+    assert "rainbow_phase" not in run([base(sun=SUN, atmosphere=HAZE)])["seen"][0]
+    assert "rainbow_phase" not in run([base(sun=SUN, atmosphere={"rain": {"rate": 25, "phase": "hg"}})])["seen"][0]
+    assert "rainbow_phase" not in run([base(sun=SUN, atmosphere={"rain": {"rate": 25, "density_scale": 0}})])[
+        "seen"][0]
+    result = run([base(sun=SUN, atmosphere=rain)])
+    assert result["seen"] == [["rainbow_phase"]]
+    assert result["stats"]["rainbow_phase"]["bytes"] == 3601 * 4 * 4
+
+
+def test_rainbow_table_is_rebuilt_only_when_the_rate_or_the_wavelengths_change():
+    """The table depends on the rain rate and the wavelength count, not on the drop density: a
+    fading rain (density 1 -> 0.01) re-uses one table; another rate or wavelength count builds one."""
+    fading = [base(sun=SUN, atmosphere={"rain": {"rate": 25, "density_scale": d}}) for d in (1, 0.3, 0.01)]
+    other_rate = base(sun=SUN, atmosphere={"rain": {"rate": 5}})
+    fewer = base(sun=SUN, atmosphere={"rain": {"rate": 5}}, quality={"rainbow_wavelengths": 5})
+    assert run(fading)["stats"]["rainbow_phase"]["builds"] == 1
+    assert run(fading + [other_rate, fewer, fading[0]])["stats"]["rainbow_phase"]["builds"] == 3

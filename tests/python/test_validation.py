@@ -236,6 +236,16 @@ BAD_SCENES = [
      "atmosphere.rain.density_scale"),
     ("zero_rain_top", _set("atmosphere", {"rain": {"rate": 1, "top": 0}}), ValueError, "atmosphere.rain.top"),
     ("rain_g_minus_one", _set("atmosphere", {"rain": {"rate": 1, "g": -1}}), ValueError, "atmosphere.rain.g"),
+    ("rain_phase_unknown", _set("atmosphere", {"rain": {"rate": 1, "phase": "geometric"}}), ValueError,
+     "atmosphere.rain.phase"),
+    ("rain_phase_number", _set("atmosphere", {"rain": {"rate": 1, "phase": 0.87}}), TypeError,
+     "atmosphere.rain.phase"),
+    ("rainbow_wavelengths_four", _set("quality", {"rainbow_wavelengths": 4}), ValueError,
+     "quality.rainbow_wavelengths"),
+    ("rainbow_wavelengths_too_many", _set("quality", {"rainbow_wavelengths": 33}), ValueError,
+     "quality.rainbow_wavelengths"),
+    ("rainbow_wavelengths_float", _set("quality", {"rainbow_wavelengths": 9.5}), ValueError,
+     "quality.rainbow_wavelengths"),
 ]
 
 
@@ -556,7 +566,7 @@ def test_issue_example_loads_with_defaults_filled_in() -> None:
     atmosphere = loaded["atmosphere"]
     assert atmosphere["molecules"] == {"density_scale": 1.0}
     assert atmosphere["aerosol"] == {"visibility": 5000.0, "scale_height": 1200.0, "g": 0.7, "albedo": 0.9}
-    assert atmosphere["rain"] == {"rate": 10.0, "density_scale": 1.0, "top": 1500.0, "g": 0.87}
+    assert atmosphere["rain"] == {"rate": 10.0, "density_scale": 1.0, "top": 1500.0, "g": 0.87, "phase": "mie"}
     assert loaded["quality"]["sky_segments"] == 16
     assert airlight.load_scene(loaded) == loaded
 
@@ -614,10 +624,12 @@ def _daytime_keys(draw) -> dict[str, Any]:
             "albedo": draw(st.floats(0.0, 1.0))}
     if draw(st.booleans()):
         atmosphere["rain"] = {"rate": draw(st.floats(0.0, 1000.0)), "top": draw(st.floats(1.0, 1e5)),
-                              "density_scale": draw(st.floats(0.0, 1e6)), "g": draw(_asymmetry)}
+                              "density_scale": draw(st.floats(0.0, 1e6)), "g": draw(_asymmetry),
+                              "phase": draw(st.sampled_from(["mie", "hg"]))}
     if atmosphere or draw(st.booleans()):
         keys["atmosphere"] = atmosphere
-    keys["quality"] = {"sky_segments": draw(st.integers(2, 64))}
+    keys["quality"] = {"sky_segments": draw(st.integers(2, 64)),
+                       "rainbow_wavelengths": draw(st.sampled_from([3, 5, 9, 17]))}
     return keys
 
 
@@ -632,4 +644,5 @@ def test_random_daytime_keys_load_and_round_trip(keys) -> None:
     if loaded["sun"] is not None:
         assert np.linalg.norm(loaded["sun"]["direction"]) == pytest.approx(1.0, abs=1e-6)
     assert loaded["quality"]["sky_segments"] == keys["quality"]["sky_segments"]
+    assert loaded["quality"]["rainbow_wavelengths"] == keys["quality"]["rainbow_wavelengths"]
     assert airlight.load_scene(loaded) == loaded

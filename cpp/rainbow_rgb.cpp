@@ -1,0 +1,143 @@
+// Stage 2 of the rainbow tables (cpp/rainbow.hpp): the renderer's linear-sRGB
+// table from the embedded spectral table, per scene.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <list>
+#include <mutex>
+#include <stdexcept>
+#include <string>
+
+#include "rainbow.hpp"
+#include "shader_cpp.hpp"
+
+namespace airlight {
+
+// ---- Stage 2 ---------------------------------------------------------------
+namespace {
+struct CmfRow {
+    double wavelength, x, y, z, d65;
+};
+constexpr CmfRow kCmf[] = {
+#include "rainbow_cmf.inc"
+};
+
+// Node j's weight (hat function of the nodes' spacing) at a wavelength.
+double hat(double wavelength, double node, double spacing) {
+    return std::max(0.0, 1.0 - std::abs(wavelength - node) / spacing);
+}
+
+void check_wavelength_count(int count) {
+    if (count != 3 && count != 5 && count != 9 && count != 17)
+        throw std::invalid_argument("rainbow: the wavelength count must be 3, 5, 9 or 17, got " + std::to_string(count));
+}
+
+// Channels R, G, B, then Y (luminance) per node, each normalised to sum 1.
+std::vector<double> spectral_weights(int count) {
+    check_wavelength_count(count);
+    // XYZ to linear sRGB (IEC 61966-2-1).
+    const double m[3][3] = {{3.2406, -1.5372, -0.4986}, {-0.9689, 1.8758, 0.0415}, {0.0557, -0.2040, 1.0570}};
+    const double spacing = 340.0 / (count - 1);
+    std::vector<double> w(size_t(count) * 4, 0.0);
+    for (int j = 0; j < count; ++j) {
+        const double node = 380.0 + spacing * j;
+        for (const CmfRow& r : kCmf) {
+            const double h = hat(r.wavelength, node, spacing) * r.d65;
+            if (h == 0.0) continue;
+            for (int c = 0; c < 3; ++c) w[size_t(j) * 4 + size_t(c)] += h * (m[c][0] * r.x + m[c][1] * r.y + m[c][2] * r.z);
+            w[size_t(j) * 4 + 3] += h * r.y;
+        }
+    }
+    for (int c = 0; c < 4; ++c) {
+        double total = 0.0;
+        for (int j = 0; j < count; ++j) total += w[size_t(j) * 4 + size_t(c)];
+        for (int j = 0; j < count; ++j) w[size_t(j) * 4 + size_t(c)] /= total;
+    }
+    return w;
+}
+
+// The embedded table's index of the node that is node j of `count`.
+int spectral_node(int j, int count) { return j * ((RAINBOW_WAVELENGTHS - 1) / (count - 1)); }
+}  // namespace
+
+std::vector<float> rainbow_rgb_weights(int count) {
+    const std::vector<double> w = spectral_weights(count);
+    std::vector<float> out(size_t(count) * 3);
+    for (int j = 0; j < count; ++j)
+        for (int c = 0; c < 3; ++c) out[size_t(j) * 3 + size_t(c)] = float(w[size_t(j) * 4 + size_t(c)]);
+    return out;
+}
+
+std::vector<double> rainbow_spectral_phase(double rate, int wavelength) {
+    const RainbowSpectralTable& t = rainbow_spectral_table();
+    if (wavelength < 0 || size_t(wavelength) >= t.wavelengths_nm.size())
+        throw std::invalid_argument("rainbow: no wavelength node " + std::to_string(wavelength));
+    if (!(rate > 0.0)) throw std::invalid_argument("rainbow: the rain rate must be positive");
+    // Linear in log rate between the table's rates (0.1 * 2^k), clamped at the ends.
+    const double kf = std::clamp(std::log2(rate / t.rates.front()), 0.0, double(t.rates.size() - 1));
+    const int k0 = std::min(int(kf), int(t.rates.size()) - 2);
+    const double f = kf - k0;
+    std::vector<double> p(t.angles_deg.size());
+    for (size_t a = 0; a < p.size(); ++a)
+        p[a] = (1.0 - f) * t.at(k0, wavelength, int(a)) + f * t.at(k0 + 1, wavelength, int(a));
+    return p;
+}
+
+const Table2D& rainbow_phase_table(double rate, int count) {
+    check_wavelength_count(count);
+    static std::mutex mutex;
+    struct Cached {
+        double rate;
+        int count;
+        Table2D table;
+    };
+    static std::list<Cached> cache;  // most recent first; addresses stay valid while cached
+    static long serial = 0;
+    std::lock_guard<std::mutex> lock(mutex);
+    for (auto it = cache.begin(); it != cache.end(); ++it) {
+        if (it->rate == rate && it->count == count) {
+            cache.splice(cache.begin(), cache, it);
+            return cache.front().table;
+        }
+    }
+    const auto start = std::chrono::steady_clock::now();
+    const RainbowSpectralTable& spectral = rainbow_spectral_table();
+    const std::vector<double> w = spectral_weights(count);
+    std::vector<std::vector<double>> phases;
+    for (int j = 0; j < count; ++j) phases.push_back(rainbow_spectral_phase(rate, spectral_node(j, count)));
+    const std::vector<double>& grid = spectral.angles_deg;
+
+    Table2D t;
+    t.name = "rainbow_phase";
+    t.width = shader::RAINBOW_TABLE_N;
+    t.height = 1;
+    t.channels = 4;
+    t.texels.assign(size_t(t.width) * 4, 0.0f);
+    for (int u = 0; u < t.width; ++u) {
+        const double deg = 180.0 * u / (t.width - 1);
+        const size_t hi = std::clamp<size_t>(size_t(std::upper_bound(grid.begin(), grid.end(), deg) - grid.begin()), 1,
+                                             grid.size() - 1);
+        const size_t lo = hi - 1;
+        const double f = std::clamp((deg - grid[lo]) / (grid[hi] - grid[lo]), 0.0, 1.0);
+        double rgby[4] = {0.0, 0.0, 0.0, 0.0};
+        for (int j = 0; j < count; ++j) {
+            const double p = (1.0 - f) * phases[size_t(j)][lo] + f * phases[size_t(j)][hi];
+            for (int c = 0; c < 4; ++c) rgby[c] += w[size_t(j) * 4 + size_t(c)] * p;
+        }
+        // Colours outside the sRGB gamut (a channel below 0) are desaturated
+        // toward the luminance, keeping it, until the smallest channel is 0.
+        double s = 1.0;
+        for (int c = 0; c < 3; ++c)
+            if (rgby[c] < 0.0) s = std::min(s, rgby[3] / (rgby[3] - rgby[c]));
+        for (int c = 0; c < 3; ++c) t.texels[size_t(u) * 4 + size_t(c)] = float(rgby[3] + s * (rgby[c] - rgby[3]));
+        t.texels[size_t(u) * 4 + 3] = float(rgby[3]);
+    }
+    t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    t.serial = ++serial;
+    register_table(t);
+    cache.push_front({rate, count, std::move(t)});
+    if (cache.size() > 8) cache.pop_back();
+    return cache.front().table;
+}
+
+}  // namespace airlight
