@@ -1,17 +1,21 @@
 // Computes the rainbow's spectral phase table (cpp/rainbow.hpp, stage 1) and
 // writes it for embedding: build/cpp/make_rainbow_table --out data/rainbow_phase.bin
 // Prints, per rate, the largest Monte-Carlo standard error in the bow region.
+// --renormalise FILE rescales an existing table's forward aureole in place
+// (normalise_rainbow_aureole; tables computed since do it themselves).
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
 #include <fstream>
+#include <iterator>
+#include <stdexcept>
 #include <string>
 
 #include "rainbow.hpp"
 
 int main(int argc, char** argv) {
     airlight::RainbowSampling sampling;
-    std::string out = "data/rainbow_phase.bin";
+    std::string out = "data/rainbow_phase.bin", renormalise;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -26,11 +30,29 @@ int main(int argc, char** argv) {
         else if (a == "--threads") sampling.threads = std::stoi(value());
         else if (a == "--wavelength") sampling.wavelengths.push_back(std::stoi(value()));
         else if (a == "--out") out = value();
+        else if (a == "--renormalise") renormalise = value();
         else {
             std::fprintf(stderr, "make_rainbow_table: unknown option %s (--samples N --seed S --threads T "
-                                 "--wavelength I (repeatable) --out FILE)\n", a.c_str());
+                                 "--wavelength I (repeatable) --out FILE | --renormalise FILE)\n", a.c_str());
             return 2;
         }
+    }
+    if (!renormalise.empty()) {
+        std::ifstream in(renormalise, std::ios::binary);
+        const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+        try {
+            airlight::RainbowSpectralTable t = airlight::parse_rainbow_table(bytes);
+            airlight::normalise_rainbow_aureole(t);
+            const std::vector<char> fixed = airlight::serialize_rainbow_table(t);
+            std::ofstream f(renormalise, std::ios::binary);
+            f.write(fixed.data(), std::streamsize(fixed.size()));
+            if (!f) throw std::runtime_error("cannot write " + renormalise);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_rainbow_table: %s: %s\n", renormalise.c_str(), e.what());
+            return 1;
+        }
+        std::printf("renormalised %s\n", renormalise.c_str());
+        return 0;
     }
     const auto start = std::chrono::steady_clock::now();
     const airlight::RainbowSpectralTable t = airlight::compute_rainbow_spectral_table(sampling);

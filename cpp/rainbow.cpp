@@ -210,7 +210,37 @@ RainbowSpectralTable compute_rainbow_spectral_table(const RainbowSampling& sampl
             }
         }
     }
+    normalise_rainbow_aureole(table);
     return table;
+}
+
+void normalise_rainbow_aureole(RainbowSpectralTable& table) {
+    // The sampled phase integrates to 1 only in expectation; nearly all of the
+    // noise in that integral comes from the diffraction peak within 0.3
+    // degree, where a few large drops carry everything (standard errors up to
+    // 40 % per angle), while the rest of the sphere (about half of the light)
+    // is known to 0.3 %. So the aureole is rescaled: weight w = 1 up to 0.5
+    // degree, falling linearly to 0 at 1 degree, and P -> P (1 + c w) with c
+    // chosen so that the trapezoid integral over the table's grid is 1.
+    const size_t nw = table.wavelengths_nm.size(), na = table.angles_deg.size();
+    std::vector<double> theta(na), weight(na);
+    for (size_t a = 0; a < na; ++a) {
+        theta[a] = table.angles_deg[a] * kPi / 180.0;
+        weight[a] = std::clamp((1.0 - table.angles_deg[a]) / 0.5, 0.0, 1.0);
+    }
+    auto integral = [&](const float* p, bool weighted) {
+        double sum = 0.0;
+        for (size_t a = 0; a + 1 < na; ++a) {
+            auto f = [&](size_t i) { return 2.0 * kPi * p[i] * std::sin(theta[i]) * (weighted ? weight[i] : 1.0); };
+            sum += 0.5 * (f(a) + f(a + 1)) * (theta[a + 1] - theta[a]);
+        }
+        return sum;
+    };
+    for (size_t row = 0; row < table.rates.size() * nw; ++row) {
+        float* p = table.phase.data() + row * na;
+        const double c = (1.0 - integral(p, false)) / integral(p, true);
+        for (size_t a = 0; a < na; ++a) p[a] = float(p[a] * (1.0 + c * weight[a]));
+    }
 }
 
 std::vector<double> mie_sun_disc_phase(double refractive_index, double diameter_mm, double wavelength_nm,

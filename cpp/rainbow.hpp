@@ -68,6 +68,10 @@ struct RainbowSampling {
     std::vector<int> wavelengths;  // indices to compute (empty: all)
 };
 RainbowSpectralTable compute_rainbow_spectral_table(const RainbowSampling& sampling);
+// Rescales the forward aureole (below 1 degree) of each rate and wavelength so
+// that the phase integrates to exactly 1 over the sphere: the sampling's noise
+// in that integral is almost all there (compute_rainbow_spectral_table calls it).
+void normalise_rainbow_aureole(RainbowSpectralTable& table);
 
 std::vector<char> serialize_rainbow_table(const RainbowSpectralTable& table);
 RainbowSpectralTable parse_rainbow_table(const std::vector<char>& bytes);  // throws std::runtime_error

@@ -55,6 +55,30 @@ void check_file_format() {
     throws(huge, "grid size");
 }
 
+// The aureole's rescaling makes a table integrate to 1 and leaves the phase
+// beyond 1 degree alone, whatever the forward error was.
+void check_aureole_normalisation() {
+    RainbowSpectralTable t = rainbow_spectral_table();
+    const size_t na = t.angles_deg.size();
+    for (size_t a = 0; a < na; ++a)
+        if (t.angles_deg[a] < 0.7) t.phase[a] *= 1.3f;  // rate 0, wavelength 0: 30 % too bright
+    const std::vector<float> before(t.phase.begin(), t.phase.begin() + long(na));
+    normalise_rainbow_aureole(t);
+    double total = 0.0;
+    for (size_t a = 0; a + 1 < na; ++a) {
+        const double t0 = t.angles_deg[a] * M_PI / 180.0, t1 = t.angles_deg[a + 1] * M_PI / 180.0;
+        total += M_PI * (t.phase[a] * std::sin(t0) + t.phase[a + 1] * std::sin(t1)) * (t1 - t0);
+    }
+    CHECK_MSG(std::abs(total - 1.0) < 1e-5, std::to_string(total));
+    bool beyond_unchanged = true, forward_dimmed = true;
+    for (size_t a = 0; a < na; ++a) {
+        if (t.angles_deg[a] >= 1.0) beyond_unchanged = beyond_unchanged && t.phase[a] == before[a];
+        if (t.angles_deg[a] <= 0.5) forward_dimmed = forward_dimmed && t.phase[a] < 0.85f * before[a];
+    }
+    CHECK(beyond_unchanged);
+    CHECK(forward_dimmed);
+}
+
 void check_colour_weights() {
     for (int count : {3, 5, 9, 17}) {
         const std::vector<float> w = rainbow_rgb_weights(count);
@@ -113,6 +137,7 @@ void check_features() {
 int main() {
     check_embedded_table();
     check_file_format();
+    check_aureole_normalisation();
     check_colour_weights();
     check_rgb_table_and_cache();
     check_features();
