@@ -152,18 +152,73 @@ def speedup(analytic: list[dict], marched: list[dict], target: float) -> str:
     return f">{slowest / t_fast:.0f}x"
 
 
-def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+def sweep(renderer: airlight.Renderer, scene: dict, pixels, expected: np.ndarray, segments, steps,
+          gl_max_steps: int) -> dict:
+    """Frame time and error of the scattering volumes at each count of altitude levels
+    (``analytic``) and of ray marching at each step count (``march``; GL only up to
+    ``gl_max_steps``, llvmpipe's loop limit)."""
+    rows: dict = {"analytic": [], "march": []}
+    runs = [("analytic", n, {"sky_segments": n}) for n in segments]
+    runs += [("march", n, {"airlight": "march", "march_steps": n}) for n in steps
+             if renderer.backend != "gl" or n <= gl_max_steps]
+    for method, n, quality in runs:
+        s = copy.deepcopy(scene)
+        s["quality"] = quality
+        t, image = timed(renderer, s)
+        e, e95 = error_of(image, pixels, expected)
+        rows[method].append({"param": n, "seconds": t, "error": e, "error95": e95})
+    return rows
+
+
+def write_outputs(lines: list[str], results: dict, scenes, backends, out: Path | None,
+                  plot: Path | None) -> None:
+    """The table as text, and the time-against-error plot (one panel a scene) with its data."""
+    if out:
+        out.parent.mkdir(parents=True, exist_ok=True)
+        out.write_text("\n".join(lines) + "\n", encoding="utf-8")
+    if not plot:
+        return
+    import matplotlib
+
+    matplotlib.use("Agg")
+    import matplotlib.pyplot as plt
+
+    fig, axes = plt.subplots(1, len(scenes), figsize=(5 * len(scenes), 4), sharey=True)
+    for ax, name in zip(np.atleast_1d(axes), scenes):
+        for backend, style in zip(backends, ("-", "--")):
+            data = results[name][backend]
+            for method, marker in (("analytic", "o"), ("march", "s")):
+                pts = sorted((m["error"], m["seconds"]) for m in data[method])
+                ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, marker=marker,
+                          label=f"{method} ({backend})")
+        ax.axvline(0.01, color="grey", lw=0.5)
+        ax.set_title(name)
+        ax.set_xlabel("max relative error")
+    np.atleast_1d(axes)[0].set_ylabel("frame time (s)")
+    np.atleast_1d(axes)[0].legend(fontsize=8)
+    fig.tight_layout()
+    plot.parent.mkdir(parents=True, exist_ok=True)
+    fig.savefig(plot, dpi=90)
+    plot.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
+
+
+def sweep_arguments(doc: str | None, height: int, segments: list[int]) -> argparse.Namespace:
+    """The command line shared by the daytime and rainbow benchmarks."""
+    ap = argparse.ArgumentParser(description=doc, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--width", type=int, default=320)
-    ap.add_argument("--height", type=int, default=180)
+    ap.add_argument("--height", type=int, default=height)
     ap.add_argument("--samples", type=int, default=120)
-    ap.add_argument("--segments", type=int, nargs="+", default=[2, 4, 8, 16, 32, 64])
+    ap.add_argument("--segments", type=int, nargs="+", default=segments)
     ap.add_argument("--steps", type=int, nargs="+", default=[16, 64, 256, 1024, 4096])
     ap.add_argument("--gl-max-steps", type=int, default=1024)
     ap.add_argument("--backends", nargs="+", default=["cpu", "gl"])
     ap.add_argument("--out", type=Path)
     ap.add_argument("--plot", type=Path)
-    args = ap.parse_args()
+    return ap.parse_args()
+
+
+def main() -> None:
+    args = sweep_arguments(__doc__, 180, [2, 4, 8, 16, 32, 64])
     lines: list[str] = []
 
     def say(text: str = "") -> None:
@@ -190,21 +245,7 @@ def main() -> None:
                 bare = copy.deepcopy(scene)
                 bare.pop("atmosphere")
                 t_bare, _ = timed(r, bare)
-                rows = {"analytic": [], "march": []}
-                for n in args.segments:
-                    s = copy.deepcopy(scene)
-                    s["quality"] = {"sky_segments": n}
-                    t, image = timed(r, s)
-                    e, e95 = error_of(image, pixels, expected)
-                    rows["analytic"].append({"param": n, "seconds": t, "error": e, "error95": e95})
-                for n in args.steps:
-                    if backend == "gl" and n > args.gl_max_steps:
-                        continue
-                    s = copy.deepcopy(scene)
-                    s["quality"] = {"airlight": "march", "march_steps": n}
-                    t, image = timed(r, s)
-                    e, e95 = error_of(image, pixels, expected)
-                    rows["march"].append({"param": n, "seconds": t, "error": e, "error95": e95})
+                rows = sweep(r, scene, pixels, expected, args.segments, args.steps, args.gl_max_steps)
             results.setdefault(name, {})[backend] = {"no_atmosphere_seconds": t_bare, **rows}
             say(f"\n### {backend}: frame without the atmosphere {t_bare * 1e3:.1f} ms\n")
             say("| method | parameter | frame (ms) | atmosphere part (ms) | max error | 95th pct error |")
@@ -223,33 +264,7 @@ def main() -> None:
     if stats:
         say(f"\nsky table: {stats['builds']} builds in this run, the last {stats['width']}x{stats['height']} "
             f"RGBA ({stats['bytes'] / 2**20:.1f} MiB) in {stats['build_seconds']:.3f} s")
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, axes = plt.subplots(1, len(SCENES), figsize=(5 * len(SCENES), 4), sharey=True)
-        for ax, name in zip(np.atleast_1d(axes), SCENES):
-            for backend, style in zip(backends, ("-", "--")):
-                data = results[name][backend]
-                for method, marker in (("analytic", "o"), ("march", "s")):
-                    pts = sorted((m["error"], m["seconds"]) for m in data[method])
-                    ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, marker=marker,
-                              label=f"{method} ({backend})")
-            ax.axvline(0.01, color="grey", lw=0.5)
-            ax.set_title(name)
-            ax.set_xlabel("max relative error")
-        np.atleast_1d(axes)[0].set_ylabel("frame time (s)")
-        np.atleast_1d(axes)[0].legend(fontsize=8)
-        fig.tight_layout()
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=90)
-        args.plot.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
-
+    write_outputs(lines, results, SCENES, backends, args.out, args.plot)
 
 if __name__ == "__main__":
     main()

@@ -23,7 +23,6 @@ is the table lookup's cost. Time: median of 3 frames after a warm-up frame. Timi
 
 from __future__ import annotations
 
-import argparse
 import copy
 import json
 import math
@@ -41,7 +40,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import daytime_reference as ref  # noqa: E402
 import reference  # noqa: E402
-from bench_daytime import error_of, speedup, timed  # noqa: E402
+from bench_daytime import speedup, sweep, sweep_arguments, timed, write_outputs  # noqa: E402
 from daytime_scenes import reference_atmosphere, reference_sky  # noqa: E402
 
 SCENES = ("rainbow_after_heavy_rain", "rainbow_after_light_rain")
@@ -90,17 +89,7 @@ def reference_values(scene: dict, pixels) -> np.ndarray:
 
 
 def main() -> None:
-    ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
-    ap.add_argument("--width", type=int, default=320)
-    ap.add_argument("--height", type=int, default=200)
-    ap.add_argument("--samples", type=int, default=120)
-    ap.add_argument("--segments", type=int, nargs="+", default=[4, 8, 16, 32])
-    ap.add_argument("--steps", type=int, nargs="+", default=[16, 64, 256, 1024, 4096])
-    ap.add_argument("--gl-max-steps", type=int, default=1024)
-    ap.add_argument("--backends", nargs="+", default=["cpu", "gl"])
-    ap.add_argument("--out", type=Path)
-    ap.add_argument("--plot", type=Path)
-    args = ap.parse_args()
+    args = sweep_arguments(__doc__, 200, [4, 8, 16, 32])
     lines: list[str] = []
 
     def say(text: str = "") -> None:
@@ -120,7 +109,7 @@ def main() -> None:
     for rate in (0.3, 3.0, 30.0, 300.0):
         airlight.rainbow_phase(rate)
     per_table = (time.perf_counter() - t0) / 4
-    say(f"renderer's RGB table per scene (interpolation in rate, 17 wavelengths to sRGB, 3601 texels, "
+    say(f"renderer's RGB table per scene (interpolation in rate, 33 wavelengths to sRGB, 3601 texels, "
         f"{3601 * 16 / 1024:.0f} KiB): {per_table * 1e3:.2f} ms\n")
     rng = np.random.default_rng(7)
     results: dict = {}
@@ -139,21 +128,7 @@ def main() -> None:
                 r.render(hg)
                 t_mie, _ = timed(r, scene)
                 t_hg, _ = timed(r, hg)
-                rows: dict = {"analytic": [], "march": []}
-                for n in args.segments:
-                    s = copy.deepcopy(scene)
-                    s["quality"] = {"sky_segments": n}
-                    t, image = timed(r, s)
-                    e, e95 = error_of(image, pixels, expected)
-                    rows["analytic"].append({"param": n, "seconds": t, "error": e, "error95": e95})
-                for n in args.steps:
-                    if backend == "gl" and n > args.gl_max_steps:
-                        continue
-                    s = copy.deepcopy(scene)
-                    s["quality"] = {"airlight": "march", "march_steps": n}
-                    t, image = timed(r, s)
-                    e, e95 = error_of(image, pixels, expected)
-                    rows["march"].append({"param": n, "seconds": t, "error": e, "error95": e95})
+                rows = sweep(r, scene, pixels, expected, args.segments, args.steps, args.gl_max_steps)
             results.setdefault(name, {})[backend] = {"rainbow_seconds": t_mie, "hg_seconds": t_hg, **rows}
             say(f"\n### {backend}: frame with the rainbow term {t_mie * 1e3:.1f} ms, without (HG rain) "
                 f"{t_hg * 1e3:.1f} ms (ratio {t_mie / t_hg:.2f})\n")
@@ -165,33 +140,7 @@ def main() -> None:
                         f"{m['error95']:.2e} |")
             ups = ", ".join(f"{t:.1%}: {speedup(rows['analytic'], rows['march'], t)}" for t in TARGETS)
             say(f"\nspeed-up of the scattering volumes over marching at equal error: {ups}")
-    if args.out:
-        args.out.parent.mkdir(parents=True, exist_ok=True)
-        args.out.write_text("\n".join(lines) + "\n", encoding="utf-8")
-    if args.plot:
-        import matplotlib
-
-        matplotlib.use("Agg")
-        import matplotlib.pyplot as plt
-
-        fig, axes = plt.subplots(1, len(SCENES), figsize=(5 * len(SCENES), 4), sharey=True)
-        for ax, name in zip(np.atleast_1d(axes), SCENES):
-            for backend, style in zip(backends, ("-", "--")):
-                data = results[name][backend]
-                for method, marker in (("analytic", "o"), ("march", "s")):
-                    pts = sorted((m["error"], m["seconds"]) for m in data[method])
-                    ax.loglog([p[0] for p in pts], [p[1] for p in pts], style, marker=marker,
-                              label=f"{method} ({backend})")
-            ax.axvline(0.01, color="grey", lw=0.5)
-            ax.set_title(name)
-            ax.set_xlabel("max relative error")
-        np.atleast_1d(axes)[0].set_ylabel("frame time (s)")
-        np.atleast_1d(axes)[0].legend(fontsize=8)
-        fig.tight_layout()
-        args.plot.parent.mkdir(parents=True, exist_ok=True)
-        fig.savefig(args.plot, dpi=90)
-        args.plot.with_suffix(".json").write_text(json.dumps(results, indent=1), encoding="utf-8")
-
+    write_outputs(lines, results, SCENES, backends, args.out, args.plot)
 
 if __name__ == "__main__":
     main()

@@ -4,12 +4,12 @@ rate, how many wavelengths the colours need, and what interpolating in rate cost
     .venv/bin/python benchmarks/rainbow_analysis.py [--out docs/rainbow_analysis.txt]
         [--plot docs/images/rainbow_rates.png]
 
-1. Rain-rate dependence: per rate, the primary bow's width (degrees of its luminance above half
-   its height over the dark band), its largest saturation (max - min) / max of RGB, the angles of
-   its red and blue maxima, and the secondary's contrast over the dark band.
-2. Colour convergence in wavelengths: the RGB table from 3, 5 and 9 of the 17 spectral nodes
-   against all 17, as the largest difference over 120-145 degrees relative to the luminance peak;
-   and 17 against the 9 that it refines (the error estimate of the 17 themselves).
+1. Rain-rate dependence: per rate of the table, the primary bow's width and contrast at 550 nm,
+   the secondary's contrast, the separation of the colours, the RGB table's red and blue maxima
+   and saturation (bow_measures).
+2. Colour convergence in wavelengths: the RGB table from 3, 5, 9 and 17 of the 33 spectral
+   nodes against all 33, as the largest difference over 120-145 degrees relative to the luminance
+   peak, and the error of the 33 themselves estimated from the rate of convergence.
 3. Interpolation in rate: the table's rates are a factor 2 apart and the renderer interpolates
    linearly in log rate. Interpolating node k from nodes k - 1 and k + 1 (a factor 4 apart)
    against node k bounds the error from above (linear interpolation's error grows as the square
@@ -29,25 +29,44 @@ from airlight import _core
 
 GRID = np.linspace(0.0, 180.0, 3601)
 LUMA = np.array([0.2126, 0.7152, 0.0722])
-RATES = (0.1, 0.3, 1.0, 3.0, 10.0, 25.0, 50.0, 100.0, 200.0)
+BOW_ANGLES = np.linspace(120.0, 146.0, 521)
 
 
-def bow_measures(rate: float) -> dict:
+def spectral_bow(table: dict, k: int, node: int) -> np.ndarray:
+    """Rate k's phase at wavelength node `node` on BOW_ANGLES (0.05 degree)."""
+    return np.interp(BOW_ANGLES, table["angles_deg"], table["phase"][k, node].astype(float))
+
+
+def monochrome_bow(p: np.ndarray) -> tuple[float, float, float, float]:
+    """Primary maximum's angle, width above half its height over the dark band's floor, its
+    contrast peak / floor, and the secondary's contrast (maximum in 124-131 over the floor)."""
+    floor = float(p[(BOW_ANGLES > 129.0) & (BOW_ANGLES < 136.0)].min())
+    primary = BOW_ANGLES > 134.0
+    peak = float(p[primary].max())
+    width = float(np.count_nonzero(primary & (p > floor + 0.5 * (peak - floor))) * 0.05)
+    at = float(BOW_ANGLES[primary][np.argmax(p[primary])])
+    secondary = float(p[(BOW_ANGLES > 124.0) & (BOW_ANGLES < 131.0)].max())
+    return at, width, peak / floor, secondary / floor
+
+
+def bow_measures(table: dict, k: int) -> dict:
+    """Rate k's bows: at 550 nm (node 16) the primary's width and contrast and the secondary's
+    contrast; the colours' separation (spread of the 33 wavelengths' primary maxima in units of
+    their mean width: below about 2 the colours overlap into a pale bow); and from the RGB table the
+    red and blue maxima and the largest saturation (max - min) / max (1 where the bow's colour
+    leaves the sRGB gamut)."""
+    rate = float(table["rates"][k])
+    per_node = [monochrome_bow(spectral_bow(table, k, i)) for i in range(len(table["wavelengths_nm"]))]
+    peaks = [m[0] for m in per_node]
+    _, width, contrast, secondary = per_node[16]
     rgb = airlight.rainbow_phase(rate).astype(float)
-    lum = rgb @ LUMA
-    band_mask = (GRID > 130.0) & (GRID < 136.0)
-    band = float(lum[band_mask].min())
-    primary = (GRID > 132.0) & (GRID < 146.0)
-    peak = float(lum[primary].max())
-    width = float(np.count_nonzero(primary & (lum > band + 0.5 * (peak - band))) * (GRID[1] - GRID[0]))
-    sat = (rgb.max(axis=1) - rgb.min(axis=1)) / np.maximum(rgb.max(axis=1), 1e-30)
     in_primary = (GRID > 134.0) & (GRID < 142.0)
     red = float(GRID[in_primary][np.argmax(rgb[in_primary, 0])])
     blue = float(GRID[in_primary][np.argmax(rgb[in_primary, 2])])
-    secondary = (GRID > 124.0) & (GRID < 131.0)
-    sec_peak = float(lum[secondary].max())
-    return {"rate": rate, "width_deg": width, "saturation": float(sat[primary].max()), "red_max_deg": red,
-            "blue_max_deg": blue, "primary_over_band": peak / band, "secondary_over_band": sec_peak / band}
+    sat = (rgb.max(axis=1) - rgb.min(axis=1)) / np.maximum(rgb.max(axis=1), 1e-30)
+    return {"rate": rate, "width_deg": width, "contrast": contrast, "secondary_contrast": secondary,
+            "colour_separation": (max(peaks) - min(peaks)) / float(np.mean([m[1] for m in per_node])),
+            "red_max_deg": red, "blue_max_deg": blue, "rgb_saturation": float(sat[in_primary].max())}
 
 
 def main() -> None:
@@ -63,27 +82,34 @@ def main() -> None:
 
     say("# Rainbow table measurements (benchmarks/rainbow_analysis.py)\n")
     say("## 1. Rain-rate dependence (Marshall-Palmer drops of 0.1-3.5 mm, seen through the sun's disc)\n")
-    say("| rate (mm/h) | primary width (deg) | max saturation | red max (deg) | blue max (deg) | "
-        "primary / band | secondary / band |")
-    say("|---|---|---|---|---|---|---|")
-    measures = [bow_measures(r) for r in RATES]
+    say("| rate (mm/h) | width at 550 nm (deg) | primary / band | secondary / band | colour separation | "
+        "red max (deg) | blue max (deg) | RGB saturation |")
+    say("|---|---|---|---|---|---|---|---|")
+    t = _core.rainbow_spectral_table()
+    measures = [bow_measures(t, k) for k in range(len(t["rates"]))]
     for m in measures:
-        say(f"| {m['rate']:g} | {m['width_deg']:.2f} | {m['saturation']:.3f} | {m['red_max_deg']:.2f} | "
-            f"{m['blue_max_deg']:.2f} | {m['primary_over_band']:.2f} | {m['secondary_over_band']:.2f} |")
+        say(f"| {m['rate']:g} | {m['width_deg']:.2f} | {m['contrast']:.1f} | {m['secondary_contrast']:.1f} | "
+            f"{m['colour_separation']:.2f} | {m['red_max_deg']:.2f} | {m['blue_max_deg']:.2f} | "
+            f"{m['rgb_saturation']:.3f} |")
 
-    say("\n## 2. Colour convergence in wavelengths (120-145 degrees; difference / luminance peak)\n")
-    say("| rate (mm/h) | 3 vs 17 | 5 vs 17 | 9 vs 17 |")
-    say("|---|---|---|---|")
+    say("\n## 2. Colour convergence in wavelengths (RGB table over 120-145 degrees against the one from "
+        "all 33 "
+        "nodes; largest channel difference / luminance peak, and the mean in parentheses)\n")
+    say("| rate (mm/h) | 3 vs 33 | 5 vs 33 | 9 vs 33 | 17 vs 33 | estimated error of 33 |")
+    say("|---|---|---|---|---|---|")
     bow = (GRID >= 120.0) & (GRID <= 145.0)
     for rate in (1.0, 10.0, 50.0):
-        full = airlight.rainbow_phase(rate, wavelengths=17).astype(float)
-        peak = float((full[bow] @ LUMA).max())
-        diffs = [float(np.abs(airlight.rainbow_phase(rate, wavelengths=n)[bow] - full[bow]).max()) / peak
-                 for n in (3, 5, 9)]
-        say(f"| {rate:g} | {diffs[0]:.3f} | {diffs[1]:.3f} | {diffs[2]:.3f} |")
+        full = airlight.rainbow_phase(rate, wavelengths=33).astype(float)[bow]
+        peak = float((full @ LUMA).max())
+        diffs = [np.abs(airlight.rainbow_phase(rate, wavelengths=n)[bow] - full) / peak
+                 for n in (3, 5, 9, 17)]
+        # Each halving of the spacing divides the error E by q. Against 33: e(17) = (q - 1) E(33)
+        # and e(9) = (q^2 - 1) E(33), so q = e(9) / e(17) - 1 and E(33) = e(17) / (q - 1).
+        q = diffs[2].max() / diffs[3].max() - 1.0
+        cells = " | ".join(f"{d.max():.3f} ({d.mean():.4f})" for d in diffs)
+        say(f"| {rate:g} | {cells} | {diffs[3].max() / (q - 1.0):.3f} (q = {q:.1f}) |")
 
     say("\n## 3. Interpolation in rate (node k from k - 1 and k + 1, factor 4 apart; 120-145 degrees)\n")
-    t = _core.rainbow_spectral_table()
     mask = (t["angles_deg"] >= 120.0) & (t["angles_deg"] <= 145.0)
     say("| rate (mm/h) | largest relative error over wavelengths and angles | median |")
     say("|---|---|---|")
@@ -114,12 +140,15 @@ def main() -> None:
             ax.set_xlabel("scattering angle (degrees)")
         ax = axes[2]
         rates = [m["rate"] for m in measures]
-        ax.semilogx(rates, [m["width_deg"] for m in measures], "o-", label="primary width (deg)")
+        ax.semilogx(rates, [m["width_deg"] for m in measures], "o-", label="primary width at 550 nm (deg)")
+        ax.semilogx(rates, [m["colour_separation"] for m in measures], "^-", label="colour separation")
         ax2 = ax.twinx()
-        ax2.semilogx(rates, [m["saturation"] for m in measures], "s--", color="C1", label="max saturation")
+        ax2.semilogx(rates, [m["contrast"] for m in measures], "s--", color="C2", label="primary / band")
         ax.set_xlabel("rain rate (mm/h)")
-        ax.set_ylabel("width (deg)")
-        ax2.set_ylabel("saturation")
+        ax.set_ylabel("width (deg), separation")
+        ax2.set_ylabel("primary / dark band at 550 nm")
+        ax.legend(loc="upper left", fontsize=8)
+        ax2.legend(loc="lower right", fontsize=8)
         ax.set_title("primary bow against rain rate")
         fig.tight_layout()
         args.plot.parent.mkdir(parents=True, exist_ok=True)

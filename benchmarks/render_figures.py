@@ -17,6 +17,11 @@
   fields and buildings on a clear day, in heavy rain and in light rain
   (scenes/day_*.json, each saved by the demo with its own display settings:
   automatic exposure, filmic curve), side by side.
+- rainbows.png: the source paper's figure 7 (issue 7): after heavy rain and
+  after light rain (scenes/rainbow_after_*.json, saved by the demo), side by
+  side; rain_ends.png: the end of the heavy shower (airlight-demo --sequence
+  rain-ends, 6 frames at 320x200): the sun comes out, the bow appears and
+  fades with the drops.
 
 The first figures use the linear curve (``--tonemap linear``) with the
 exposures above, as before the display stage existed.
@@ -78,11 +83,36 @@ def day_weather_strip(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 
+def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
+    """The two figure-7 presets side by side, and the rain-ends sequence as a strip."""
+    with tempfile.TemporaryDirectory() as tmp:
+        tiles = []
+        for name in ("rainbow_after_heavy_rain", "rainbow_after_light_rain"):
+            demo(name, Path(tmp) / f"{name}.png", backend)
+            with Image.open(Path(tmp) / f"{name}.png") as png:
+                tiles.append(np.asarray(png.convert("RGB")))
+            tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
+        Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
+        frames = Path(tmp) / "frames"
+        demo("rainbow_after_heavy_rain", frames, backend, "--sequence", "rain-ends", "--frames", "6",
+             "--width", "320", "--height", "200")
+        tiles = []
+        for path in sorted(frames.glob("frame_*.png")):
+            with Image.open(path) as png:
+                tiles.append(np.asarray(png.convert("RGB")))
+            tiles.append(np.full((tiles[-1].shape[0], 4, 3), 255, np.uint8))
+        Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(sequence_out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
+    ap.add_argument("--only", choices=["rainbows"], help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
+    rainbow_figures(args.backend, IMAGES / "rainbows.png", IMAGES / "rain_ends.png")
+    if args.only == "rainbows":
+        return
     demo("foggy_street", IMAGES / "foggy_street.png", args.backend, "--exposure", "0.1",
          "--tonemap", "linear")
     demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", args.backend, "--exposure", "0.03",
@@ -101,7 +131,8 @@ def main() -> None:
         crane = r.render(airlight.preset("crane_searchlight"))
         airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
     print(f"wrote {IMAGES}/foggy_street.png, foggy_street_hg.png, spotlights_crossing.png, "
-          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png, day_weather.png")
+          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png, day_weather.png, rainbows.png, "
+          "rain_ends.png")
 
 
 if __name__ == "__main__":

@@ -264,7 +264,8 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
         char name[80];
-        std::snprintf(name, sizeof name, "/frame_%02d_density_%.4f.png", k, double(frame.atmosphere.rain.density_scale));
+        std::snprintf(name, sizeof name, "/frame_%02d_density_%.4f.png", k,
+                      double(frame.atmosphere.rain.density_scale));
         const std::string path = o.out + name;
         write_png(path, shown.width, shown.height, shown.srgb8);
         print_report(path, image, backend, ms, &shown.report);

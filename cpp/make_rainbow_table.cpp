@@ -1,8 +1,11 @@
 // Computes the rainbow's spectral phase table (cpp/rainbow.hpp, stage 1) and
 // writes it for embedding: build/cpp/make_rainbow_table --out data/rainbow_phase.bin
 // Prints, per rate, the largest Monte-Carlo standard error in the bow region.
+// --merge FILE adds the wavelengths of an existing table (same rates, angles
+// and samples) to the ones computed, for refining the wavelength grid.
 // --renormalise FILE rescales an existing table's forward aureole in place
 // (normalise_rainbow_aureole; tables computed since do it themselves).
+#include <algorithm>
 #include <chrono>
 #include <cstdio>
 #include <cstdlib>
@@ -10,12 +13,54 @@
 #include <iterator>
 #include <stdexcept>
 #include <string>
+#include <utility>
+#include <vector>
 
 #include "rainbow.hpp"
 
+namespace {
+
+airlight::RainbowSpectralTable read_table(const std::string& path) {
+    std::ifstream in(path, std::ios::binary);
+    if (!in) throw std::runtime_error("cannot read");
+    const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
+    return airlight::parse_rainbow_table(bytes);
+}
+
+// The union of two tables' wavelengths, in increasing order.
+airlight::RainbowSpectralTable merged(const airlight::RainbowSpectralTable& a,
+                                      const airlight::RainbowSpectralTable& b) {
+    if (a.rates != b.rates || a.angles_deg != b.angles_deg || a.samples_per_wavelength != b.samples_per_wavelength)
+        throw std::runtime_error("rates, angles or samples differ from the computed table's");
+    airlight::RainbowSpectralTable m = a;
+    m.wavelengths_nm.clear();
+    std::vector<std::pair<double, std::pair<const airlight::RainbowSpectralTable*, size_t>>> order;
+    for (size_t i = 0; i < a.wavelengths_nm.size(); ++i) order.push_back({a.wavelengths_nm[i], {&a, i}});
+    for (size_t i = 0; i < b.wavelengths_nm.size(); ++i) order.push_back({b.wavelengths_nm[i], {&b, i}});
+    std::sort(order.begin(), order.end(), [](const auto& x, const auto& y) { return x.first < y.first; });
+    for (size_t i = 0; i + 1 < order.size(); ++i)
+        if (order[i].first == order[i + 1].first) throw std::runtime_error("both tables hold a wavelength");
+    const size_t nw = order.size(), na = a.angles_deg.size();
+    m.phase.assign(a.rates.size() * nw * na, 0.0f);
+    m.rel_error.assign(m.phase.size(), 0.0f);
+    for (size_t w = 0; w < nw; ++w) {
+        m.wavelengths_nm.push_back(order[w].first);
+        const airlight::RainbowSpectralTable& src = *order[w].second.first;
+        const size_t sw = order[w].second.second, snw = src.wavelengths_nm.size();
+        for (size_t k = 0; k < a.rates.size(); ++k)
+            for (size_t x = 0; x < na; ++x) {
+                m.phase[(k * nw + w) * na + x] = src.phase[(k * snw + sw) * na + x];
+                m.rel_error[(k * nw + w) * na + x] = src.rel_error[(k * snw + sw) * na + x];
+            }
+    }
+    return m;
+}
+
+}  // namespace
+
 int main(int argc, char** argv) {
     airlight::RainbowSampling sampling;
-    std::string out = "data/rainbow_phase.bin", renormalise;
+    std::string out = "data/rainbow_phase.bin", renormalise, merge;
     for (int i = 1; i < argc; ++i) {
         const std::string a = argv[i];
         auto value = [&]() -> std::string {
@@ -25,23 +70,31 @@ int main(int argc, char** argv) {
             }
             return argv[++i];
         };
-        if (a == "--samples") sampling.samples_per_wavelength = std::stoi(value());
-        else if (a == "--seed") sampling.seed = std::stoull(value());
-        else if (a == "--threads") sampling.threads = std::stoi(value());
-        else if (a == "--wavelength") sampling.wavelengths.push_back(std::stoi(value()));
-        else if (a == "--out") out = value();
-        else if (a == "--renormalise") renormalise = value();
+        if (a == "--samples")
+            sampling.samples_per_wavelength = std::stoi(value());
+        else if (a == "--seed")
+            sampling.seed = std::stoull(value());
+        else if (a == "--threads")
+            sampling.threads = std::stoi(value());
+        else if (a == "--wavelength")
+            sampling.wavelengths.push_back(std::stoi(value()));
+        else if (a == "--out")
+            out = value();
+        else if (a == "--renormalise")
+            renormalise = value();
+        else if (a == "--merge")
+            merge = value();
         else {
-            std::fprintf(stderr, "make_rainbow_table: unknown option %s (--samples N --seed S --threads T "
-                                 "--wavelength I (repeatable) --out FILE | --renormalise FILE)\n", a.c_str());
+            std::fprintf(stderr,
+                         "make_rainbow_table: unknown option %s (--samples N --seed S --threads T "
+                         "--wavelength I (repeatable) --out FILE --merge FILE | --renormalise FILE)\n",
+                         a.c_str());
             return 2;
         }
     }
     if (!renormalise.empty()) {
-        std::ifstream in(renormalise, std::ios::binary);
-        const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
         try {
-            airlight::RainbowSpectralTable t = airlight::parse_rainbow_table(bytes);
+            airlight::RainbowSpectralTable t = read_table(renormalise);
             airlight::normalise_rainbow_aureole(t);
             const std::vector<char> fixed = airlight::serialize_rainbow_table(t);
             std::ofstream f(renormalise, std::ios::binary);
@@ -55,8 +108,24 @@ int main(int argc, char** argv) {
         return 0;
     }
     const auto start = std::chrono::steady_clock::now();
-    const airlight::RainbowSpectralTable t = airlight::compute_rainbow_spectral_table(sampling);
+    // Read before computing: a bad file is reported at once, not after minutes.
+    airlight::RainbowSpectralTable earlier;
+    try {
+        if (!merge.empty()) earlier = read_table(merge);
+    } catch (const std::exception& e) {
+        std::fprintf(stderr, "make_rainbow_table: %s: %s\n", merge.c_str(), e.what());
+        return 1;
+    }
+    airlight::RainbowSpectralTable t = airlight::compute_rainbow_spectral_table(sampling);
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    if (!merge.empty()) {
+        try {
+            t = merged(t, earlier);
+        } catch (const std::exception& e) {
+            std::fprintf(stderr, "make_rainbow_table: %s: %s\n", merge.c_str(), e.what());
+            return 1;
+        }
+    }
     std::printf("%zu wavelengths x %d samples in %.1f s\n", t.wavelengths_nm.size(), t.samples_per_wavelength, seconds);
     std::printf("rate mm/h | largest relative standard error, 120-145 deg (over wavelengths) | at the primary max\n");
     const size_t nw = t.wavelengths_nm.size(), na = t.angles_deg.size();

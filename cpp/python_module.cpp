@@ -16,8 +16,8 @@
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
-#include "scene_json.hpp"
 #include "rainbow.hpp"
+#include "scene_json.hpp"
 #include "tables.hpp"
 
 namespace py = pybind11;
@@ -265,8 +265,8 @@ PYBIND11_MODULE(_core, m) {
         "rainbow_phase_table",
         [](double rate, int wavelengths) {
             if (!(rate > 0.0) || !std::isfinite(rate)) throw py::value_error("rate: must be a positive number (mm/h)");
-            if (wavelengths != 3 && wavelengths != 5 && wavelengths != 9 && wavelengths != 17)
-                throw py::value_error("wavelengths: must be 3, 5, 9 or 17");
+            if (!airlight::is_rainbow_wavelength_count(wavelengths))
+                throw py::value_error(std::string("wavelengths: must be ") + airlight::RAINBOW_WAVELENGTH_COUNTS);
             const airlight::Table2D& t = airlight::rainbow_phase_table(rate, wavelengths);
             py::array_t<float> out({t.width, 4});
             std::memcpy(out.mutable_data(), t.texels.data(), t.texels.size() * sizeof(float));
@@ -293,24 +293,24 @@ PYBIND11_MODULE(_core, m) {
                 computed = airlight::compute_rainbow_spectral_table(s);
             }
             const airlight::RainbowSpectralTable& t = samples != 0 ? computed : airlight::rainbow_spectral_table();
-        const py::ssize_t nr = py::ssize_t(t.rates.size()), nw = py::ssize_t(t.wavelengths_nm.size()),
-                          na = py::ssize_t(t.angles_deg.size());
-        py::array_t<float> phase({nr, nw, na}), rel_error({nr, nw, na});
-        std::memcpy(phase.mutable_data(), t.phase.data(), t.phase.size() * sizeof(float));
-        std::memcpy(rel_error.mutable_data(), t.rel_error.data(), t.rel_error.size() * sizeof(float));
-        py::dict d;
-        d["wavelengths_nm"] = py::array_t<double>(py::ssize_t(nw), t.wavelengths_nm.data());
-        d["rates"] = py::array_t<double>(py::ssize_t(nr), t.rates.data());
-        d["angles_deg"] = py::array_t<double>(py::ssize_t(na), t.angles_deg.data());
-        d["phase"] = phase;
-        d["rel_error"] = rel_error;
-        d["samples_per_wavelength"] = t.samples_per_wavelength;
-        return d;
+            const py::ssize_t nr = py::ssize_t(t.rates.size()), nw = py::ssize_t(t.wavelengths_nm.size()),
+                              na = py::ssize_t(t.angles_deg.size());
+            py::array_t<float> phase({nr, nw, na}), rel_error({nr, nw, na});
+            std::memcpy(phase.mutable_data(), t.phase.data(), t.phase.size() * sizeof(float));
+            std::memcpy(rel_error.mutable_data(), t.rel_error.data(), t.rel_error.size() * sizeof(float));
+            py::dict d;
+            d["wavelengths_nm"] = py::array_t<double>(py::ssize_t(nw), t.wavelengths_nm.data());
+            d["rates"] = py::array_t<double>(py::ssize_t(nr), t.rates.data());
+            d["angles_deg"] = py::array_t<double>(py::ssize_t(na), t.angles_deg.data());
+            d["phase"] = phase;
+            d["rel_error"] = rel_error;
+            d["samples_per_wavelength"] = t.samples_per_wavelength;
+            return d;
         },
         py::arg("samples") = 0, py::arg("seed") = 1, py::arg("wavelengths") = std::vector<int>{});
     m.def("rainbow_rgb_weights", [](int count) {
-        if (count != 3 && count != 5 && count != 9 && count != 17)
-            throw py::value_error("count: must be 3, 5, 9 or 17");
+        if (!airlight::is_rainbow_wavelength_count(count))
+            throw py::value_error(std::string("count: must be ") + airlight::RAINBOW_WAVELENGTH_COUNTS);
         const std::vector<float> w = airlight::rainbow_rgb_weights(count);
         py::array_t<float> out({py::ssize_t(count), py::ssize_t(3)});
         std::memcpy(out.mutable_data(), w.data(), w.size() * sizeof(float));
@@ -331,6 +331,21 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("refractive_index"), py::arg("diameter_mm"), py::arg("wavelength_nm"), py::arg("angles_deg"),
         py::arg("n_radial") = 12);
+    m.def(
+        "mie_size_average_phase",
+        [](double rate, double wavelength_nm, const std::vector<double>& angles_deg, int n_sizes) {
+            if (!(rate > 0.0) || !std::isfinite(rate)) throw py::value_error("rate: must be a positive number (mm/h)");
+            if (!(wavelength_nm >= 200.0 && wavelength_nm <= 2000.0))
+                throw py::value_error("wavelength_nm: must be in [200, 2000]");
+            if (n_sizes < 1 || n_sizes > 100000) throw py::value_error("n_sizes: must be in [1, 100000]");
+            std::vector<double> p;
+            {
+                py::gil_scoped_release release;
+                p = airlight::mie_size_average_phase(rate, wavelength_nm, angles_deg, n_sizes);
+            }
+            return py::array_t<double>(py::ssize_t(p.size()), p.data());
+        },
+        py::arg("rate"), py::arg("wavelength_nm"), py::arg("angles_deg"), py::arg("n_sizes"));
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

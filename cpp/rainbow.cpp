@@ -20,7 +20,7 @@ constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
 }  // namespace
 
-double rainbow_wavelength_nm(int i) { return 380.0 + 21.25 * double(i); }
+double rainbow_wavelength_nm(int i) { return 380.0 + 10.625 * double(i); }
 
 double rainbow_rate(int k) { return 0.1 * std::ldexp(1.0, k); }
 
@@ -84,7 +84,8 @@ struct SizeProposal {
         const int n = 20001;
         d.resize(n);
         pdf.assign(n, 0.0);
-        for (int i = 0; i < n; ++i) d[size_t(i)] = RAINDROP_D_MIN_MM + (RAINDROP_D_MAX_MM - RAINDROP_D_MIN_MM) * i / (n - 1);
+        for (int i = 0; i < n; ++i)
+            d[size_t(i)] = RAINDROP_D_MIN_MM + (RAINDROP_D_MAX_MM - RAINDROP_D_MIN_MM) * i / (n - 1);
         const double h = d[1] - d[0];
         for (int k = 0; k < RAINBOW_RATES; ++k) {
             const double lam = marshall_palmer_slope(rainbow_rate(k));
@@ -97,7 +98,8 @@ struct SizeProposal {
             for (int i = 0; i < n; ++i) pdf[size_t(i)] += g[size_t(i)] / total / RAINBOW_RATES;
         }
         cdf.assign(n, 0.0);
-        for (int i = 1; i < n; ++i) cdf[size_t(i)] = cdf[size_t(i) - 1] + 0.5 * (pdf[size_t(i)] + pdf[size_t(i) - 1]) * h;
+        for (int i = 1; i < n; ++i)
+            cdf[size_t(i)] = cdf[size_t(i) - 1] + 0.5 * (pdf[size_t(i)] + pdf[size_t(i) - 1]) * h;
         for (double& c : cdf) c /= cdf.back();
     }
     // Diameter at cumulative probability u, and the density there.
@@ -129,8 +131,8 @@ RainbowSpectralTable compute_rainbow_spectral_table(const RainbowSampling& sampl
     const SizeProposal proposal;
     const int n_samples = sampling.samples_per_wavelength;
     constexpr int kBatches = 16;  // batch means for the standard error
-    const unsigned threads = sampling.threads > 0 ? unsigned(sampling.threads)
-                                                  : std::max(1u, std::thread::hardware_concurrency());
+    const unsigned threads =
+        sampling.threads > 0 ? unsigned(sampling.threads) : std::max(1u, std::thread::hardware_concurrency());
     std::vector<double> theta(na);
     for (size_t a = 0; a < na; ++a) theta[a] = table.angles_deg[a] * kDeg;
     const double rho = SUN_ANGULAR_RADIUS_DEG * kDeg;
@@ -267,6 +269,41 @@ std::vector<double> mie_sun_disc_phase(double refractive_index, double diameter_
         for (size_t q = 0; q < per; ++q) p[a] += std::norm(s1[a * per + q]) + std::norm(s2[a * per + q]);
         p[a] /= norm * double(per);
     }
+    return p;
+}
+
+std::vector<double> mie_size_average_phase(double rate_mm_per_h, double wavelength_nm,
+                                           const std::vector<double>& angles_deg, int n_sizes) {
+    // Midpoint rule in log D over [D_MIN, D_MAX] with the Marshall-Palmer
+    // weight N(D) dD = N0 exp(-Lambda D) D dlnD (N0 cancels in the ratio);
+    // the sizes are shared out between threads, each with its own sums.
+    const double slope = marshall_palmer_slope(rate_mm_per_h);
+    const double lo = std::log(RAINDROP_D_MIN_MM), hi = std::log(RAINDROP_D_MAX_MM);
+    std::vector<double> theta(angles_deg.size());
+    for (size_t a = 0; a < theta.size(); ++a) theta[a] = angles_deg[a] * kDeg;
+    const unsigned threads = std::max(1u, std::min(std::thread::hardware_concurrency(), unsigned(n_sizes)));
+    std::vector<std::vector<double>> num(threads, std::vector<double>(theta.size(), 0.0));
+    std::vector<double> den(threads, 0.0);
+    std::atomic<int> next{0};
+    auto work = [&](unsigned t) {
+        std::vector<double> dc;
+        double c_sca = 0.0;
+        for (int i = next++; i < n_sizes; i = next++) {
+            const double d = std::exp(lo + (hi - lo) * (n_sizes - 1 - i + 0.5) / n_sizes);  // largest first
+            const double weight = std::exp(-slope * d) * d;
+            drop_scattering(d, wavelength_nm, theta, dc, c_sca);
+            for (size_t a = 0; a < theta.size(); ++a) num[t][a] += weight * dc[a];
+            den[t] += weight * c_sca;
+        }
+    };
+    std::vector<std::thread> pool;
+    for (unsigned t = 0; t < threads; ++t) pool.emplace_back(work, t);
+    for (std::thread& t : pool) t.join();
+    std::vector<double> p(theta.size(), 0.0);
+    double total = 0.0;
+    for (unsigned t = 0; t < threads; ++t) total += den[t];
+    for (unsigned t = 0; t < threads; ++t)
+        for (size_t a = 0; a < theta.size(); ++a) p[a] += num[t][a] / total;
     return p;
 }
 

@@ -3,7 +3,7 @@
 // wavelength, and turned into the linear-sRGB table the renderer reads.
 //
 // Two stages (docs/rainbow.md explains the choices and the measured errors):
-//  1. The spectral table (rainbow_spectral_table): for 17 wavelengths, 14
+//  1. The spectral table (rainbow_spectral_table): for 33 wavelengths, 14
 //     rainfall rates and an angle grid refined near the bows, computed from the
 //     Lorenz-Mie series (mie.cpp) by Monte-Carlo integration over drop size and
 //     the sun's disc. It takes minutes, so it is computed once
@@ -23,9 +23,11 @@
 namespace airlight {
 
 // ---- The spectral table's grids ------------------------------------------
-// Wavelengths 380 + 21.25 i nm (i = 0..16): 17 nodes, so that 9, 5 and 3 of
-// them are also evenly spaced (the colour-convergence measurement).
-constexpr int RAINBOW_WAVELENGTHS = 17;
+// Wavelengths 380 + 10.625 i nm (i = 0..32): 33 nodes, so that 17, 9, 5 and 3
+// of them are also evenly spaced (the colour-convergence measurement: each
+// halving of the spacing cuts the colour error about fourfold; 33 nodes are
+// within about 3 % of the converged bow, docs/rainbow.md).
+constexpr int RAINBOW_WAVELENGTHS = 33;
 double rainbow_wavelength_nm(int i);
 // Rates 0.1 * 2^k mm/h (k = 0..13, up to 819.2); others are interpolated in
 // log rate, and clamped to the ends.
@@ -64,7 +66,7 @@ struct RainbowSpectralTable {
 struct RainbowSampling {
     int samples_per_wavelength = 4096;  // drop-size and sun-disc samples
     std::uint64_t seed = 1;
-    int threads = 0;  // 0: all hardware threads
+    int threads = 0;               // 0: all hardware threads
     std::vector<int> wavelengths;  // indices to compute (empty: all)
 };
 RainbowSpectralTable compute_rainbow_spectral_table(const RainbowSampling& sampling);
@@ -84,13 +86,23 @@ const RainbowSpectralTable& rainbow_spectral_table();
 std::vector<double> mie_sun_disc_phase(double refractive_index, double diameter_mm, double wavelength_nm,
                                        const std::vector<double>& angles_deg, int n_radial = 12);
 
+// The size-averaged phase function at a point (no sun disc) by a
+// deterministic rule, independent of the table's Monte Carlo: midpoint rule
+// with n_sizes diameters evenly spaced in log D (tests and docs/rainbow.md).
+std::vector<double> mie_size_average_phase(double rate_mm_per_h, double wavelength_nm,
+                                           const std::vector<double>& angles_deg, int n_sizes);
+
 // ---- Stage 2: the renderer's table ----------------------------------------
 // Linear-sRGB weights of each spectral node (CIE 1931 2-degree observer, D65
 // sun spectrum, band integrals of the node's hat function), normalised so
 // that each channel's weights sum to 1: a phase function that does not depend
-// on wavelength gives the same value in R, G and B. `count`: 17, 9, 5 or 3
-// nodes (every 16 / (count - 1)-th).
+// on wavelength gives the same value in R, G and B. `count`: 33, 17, 9, 5 or 3
+// nodes (every 32 / (count - 1)-th).
 std::vector<float> rainbow_rgb_weights(int count);
+// The node counts the table supports: 3, 5, 9, 17 and 33 (evenly spaced
+// subsets of the 33 nodes).
+bool is_rainbow_wavelength_count(int count);
+constexpr const char* RAINBOW_WAVELENGTH_COUNTS = "3, 5, 9, 17 or 33";
 
 // Uniform angle axis of the renderer's table (constants.glsl).
 // Texel a holds the phase at a * 180 / (RAINBOW_TABLE_N - 1) degrees, RGB in

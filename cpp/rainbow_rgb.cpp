@@ -28,8 +28,9 @@ double hat(double wavelength, double node, double spacing) {
 }
 
 void check_wavelength_count(int count) {
-    if (count != 3 && count != 5 && count != 9 && count != 17)
-        throw std::invalid_argument("rainbow: the wavelength count must be 3, 5, 9 or 17, got " + std::to_string(count));
+    if (!is_rainbow_wavelength_count(count))
+        throw std::invalid_argument(std::string("rainbow: the wavelength count must be ") + RAINBOW_WAVELENGTH_COUNTS +
+                                    ", got " + std::to_string(count));
 }
 
 // Channels R, G, B, then Y (luminance) per node, each normalised to sum 1.
@@ -44,7 +45,8 @@ std::vector<double> spectral_weights(int count) {
         for (const CmfRow& r : kCmf) {
             const double h = hat(r.wavelength, node, spacing) * r.d65;
             if (h == 0.0) continue;
-            for (int c = 0; c < 3; ++c) w[size_t(j) * 4 + size_t(c)] += h * (m[c][0] * r.x + m[c][1] * r.y + m[c][2] * r.z);
+            for (int c = 0; c < 3; ++c)
+                w[size_t(j) * 4 + size_t(c)] += h * (m[c][0] * r.x + m[c][1] * r.y + m[c][2] * r.z);
             w[size_t(j) * 4 + 3] += h * r.y;
         }
     }
@@ -59,6 +61,13 @@ std::vector<double> spectral_weights(int count) {
 // The embedded table's index of the node that is node j of `count`.
 int spectral_node(int j, int count) { return j * ((RAINBOW_WAVELENGTHS - 1) / (count - 1)); }
 }  // namespace
+
+bool is_rainbow_wavelength_count(int count) {
+    static_assert(RAINBOW_WAVELENGTHS == 33, "the supported counts are the evenly spaced subsets of 33 nodes");
+    for (int n : {3, 5, 9, 17, 33})
+        if (count == n) return true;
+    return false;
+}
 
 std::vector<float> rainbow_rgb_weights(int count) {
     const std::vector<double> w = spectral_weights(count);

@@ -16,6 +16,7 @@
 #include <utility>
 #include <vector>
 
+#include "rainbow.hpp"
 #include "scene_json.hpp"
 
 namespace airlight {
@@ -474,11 +475,11 @@ Quality parse_quality(const Obj& o) {
     }
     if (auto v = o.opt("sky_segments")) q.sky_segments = read_int(*v, 2, 64);
     if (auto v = o.opt("rainbow_wavelengths")) {
-        q.rainbow_wavelengths = read_int(*v, 3, 17);
-        if (q.rainbow_wavelengths != 3 && q.rainbow_wavelengths != 5 && q.rainbow_wavelengths != 9 &&
-            q.rainbow_wavelengths != 17)
-            fail(Kind::value, v->field, "must be 3, 5, 9 or 17 (wavelength nodes), got " +
-                                          std::to_string(q.rainbow_wavelengths));
+        q.rainbow_wavelengths = read_int(*v, 3, RAINBOW_WAVELENGTHS);
+        if (!is_rainbow_wavelength_count(q.rainbow_wavelengths))
+            fail(Kind::value, v->field,
+                 std::string("must be ") + RAINBOW_WAVELENGTH_COUNTS + " (wavelength nodes), got " +
+                     std::to_string(q.rainbow_wavelengths));
     }
     return q;
 }

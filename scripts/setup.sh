@@ -27,7 +27,7 @@ if [ ! -x .venv/bin/python ]; then
     "$python" -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip
-.venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib \
+.venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib colour-science \
     "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy
 # --no-build-isolation: build with the tools just installed in .venv
 # (incremental: the build directory build/python is kept between runs).

@@ -193,9 +193,10 @@ struct Quality {
     // the number of altitude levels that split view rays through the
     // atmosphere (docs/daytime.md measures error against it), in [2, 64].
     int sky_segments = 16;
-    // Wavelength nodes (3, 5, 9 or 17, 380-720 nm) of the rainbow's spectral
-    // phase function turned into RGB (docs/rainbow.md measures the colour error).
-    int rainbow_wavelengths = 17;
+    // Wavelength nodes (3, 5, 9, 17 or 33, 380-720 nm) of the rainbow's
+    // spectral phase function turned into RGB (docs/rainbow.md measures the
+    // colour error of fewer).
+    int rainbow_wavelengths = 33;
 };
 
 struct Scene {

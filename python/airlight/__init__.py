@@ -423,11 +423,11 @@ def table_stats() -> dict[str, dict[str, Any]]:
     return dict(_core.tables_built())
 
 
-def rainbow_phase(rate: float, angles_deg: Any = None, *, wavelengths: int = 17) -> np.ndarray:
+def rainbow_phase(rate: float, angles_deg: Any = None, *, wavelengths: int = 33) -> np.ndarray:
     """The raindrops' phase function for sunlight that the renderer uses (rain with
     ``"phase": "mie"``; MODELS.md section 4, docs/rainbow.md): Lorenz-Mie, averaged over
     the Marshall-Palmer drop sizes of ``rate`` (mm/h), seen through the sun's
-    0.53-degree disc, converted from ``wavelengths`` spectral nodes (3, 5, 9 or 17) to
+    0.53-degree disc, converted from ``wavelengths`` spectral nodes (3, 5, 9, 17 or 33) to
     linear sRGB (CIE 1931, D65). Returns float32 (n, 3) in sr^-1 at ``angles_deg``
     (scattering angles, 0 = forward; default: the table's own 0.05-degree grid),
     interpolated linearly in angle as the shaders do."""

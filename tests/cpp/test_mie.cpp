@@ -88,7 +88,7 @@ void check_against_numpy_reference() {
     CHECK(near(qa.extinction, 2.011467157311673, 1e-10) && near(qa.scattering, 2.0113976452538904, 1e-10));
 }
 
-// Analysis for the rainbow design (docs/rainbow_design.md): the Marshall-
+// Analysis for the rainbow design (docs/rainbow.md section 2): the Marshall-
 // Palmer average of the phase function over n drop sizes (midpoints, uniform
 // in D over 0.1-3.5 mm; weight N(D) D^2 Q_sca), 550 nm, 25 mm/h, on 120-145
 // degrees every 0.1 degree; how much it changes when n doubles, pointwise

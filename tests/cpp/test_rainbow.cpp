@@ -119,7 +119,8 @@ Scene rain_scene(const std::string& rain) {
     return parse_scene(R"({"film": {"width": 4, "height": 4},
         "camera": {"position": [0, 2, 0], "look_at": [0, 2, -1], "up": [0, 1, 0], "fov_y": 60},
         "sun": {"elevation": 20, "azimuth": 180, "irradiance": [10, 10, 10]},
-        "atmosphere": {"rain": )" + rain + "}}");
+        "atmosphere": {"rain": )" +
+                       rain + "}}");
 }
 
 void check_features() {

@@ -427,7 +427,8 @@ def make_atmosphere(rain_rate: float = 0.0, visibility: float | None = None, mol
             species.append(Species("aerosol", np.full(3, ext), aerosol_albedo, aerosol_g,
                                    _truncate(aerosol_profile(aerosol_scale_height), top)))
     if rain_rate > 0.0:
-        species.append(Species("rain", np.full(3, rain_extinction(rain_rate) * rain_density_scale), RAIN_ALBEDO,
+        sigma_t = np.full(3, rain_extinction(rain_rate) * rain_density_scale)
+        species.append(Species("rain", sigma_t, RAIN_ALBEDO,
                                rain_g, _truncate(rain_profile(rain_top), top), rain_sun_phase))
     return Atmosphere(tuple(species))
 

@@ -6,10 +6,11 @@ from __future__ import annotations
 
 import math
 
-import airlight
 import daytime_reference as ref
 import numpy as np
 import reference
+
+import airlight
 
 OVERCAST = {"model": "overcast", "zenith_radiance": [1.0, 1.0, 1.0]}
 CLEAR = {"model": "cie", "type": 12, "zenith_radiance": [0.5, 0.75, 1.2]}
@@ -101,7 +102,7 @@ def _rainbow_sun_phase(scene: dict):
     """The rain's phase for sunlight that a "mie" rain uses: the library's rainbow table (an
     input of the reference, like the scene; its accuracy is tested in test_rainbow.py)."""
     rain = scene["atmosphere"]["rain"]
-    n = (scene.get("quality") or {}).get("rainbow_wavelengths", 17)
+    n = (scene.get("quality") or {}).get("rainbow_wavelengths", 33)
 
     def sun_phase(cos_theta: float) -> np.ndarray:
         angle = math.degrees(math.acos(max(-1.0, min(1.0, cos_theta))))

@@ -160,7 +160,8 @@ def test_rainbow_table_only_for_rain_lit_by_the_sun():
     rain = {"rain": {"rate": 25, "density_scale": 0.3}}
     assert "rainbow_phase" not in run([base(sky=OVERCAST, atmosphere=rain)])["seen"][0]
     assert "rainbow_phase" not in run([base(sun=SUN, atmosphere=HAZE)])["seen"][0]
-    assert "rainbow_phase" not in run([base(sun=SUN, atmosphere={"rain": {"rate": 25, "phase": "hg"}})])["seen"][0]
+    hg = base(sun=SUN, atmosphere={"rain": {"rate": 25, "phase": "hg"}})
+    assert "rainbow_phase" not in run([hg])["seen"][0]
     assert "rainbow_phase" not in run([base(sun=SUN, atmosphere={"rain": {"rate": 25, "density_scale": 0}})])[
         "seen"][0]
     result = run([base(sun=SUN, atmosphere=rain)])
