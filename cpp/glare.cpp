@@ -47,12 +47,6 @@ void parallel_for(int count, int threads, const F& body) {
 
 bool is_pow2(int n) { return n > 0 && (n & (n - 1)) == 0; }
 
-// Wyman, Sloan & Shirley 2013, piecewise Gaussian lobe.
-double lobe(double x, double mu, double sigma_lo, double sigma_hi) {
-    const double t = (x - mu) / (x < mu ? sigma_lo : sigma_hi);
-    return std::exp(-0.5 * t * t);
-}
-
 // CDF of the unit tent (hat) function centred at 0.
 double tent_cdf(double u) {
     if (u <= -1.0) return 0.0;
@@ -517,20 +511,6 @@ double camera_pixel_angle(double fov_y_deg, int height) {
     if (!(fov_y_deg > 0.0 && fov_y_deg < 180.0) || height < 1)
         throw std::invalid_argument("glare: fov_y must be in (0, 180) degrees and height >= 1");
     return 2.0 * std::tan(0.5 * fov_y_deg * kPi / 180.0) / height;
-}
-
-std::array<double, 3> cie1931_xyz(double nm) {
-    const double x =
-        1.056 * lobe(nm, 599.8, 37.9, 31.0) + 0.362 * lobe(nm, 442.0, 16.0, 26.7) - 0.065 * lobe(nm, 501.1, 20.4, 26.2);
-    const double y = 0.821 * lobe(nm, 568.8, 46.9, 40.5) + 0.286 * lobe(nm, 530.9, 16.3, 31.1);
-    const double z = 1.217 * lobe(nm, 437.0, 11.8, 36.0) + 0.681 * lobe(nm, 459.0, 26.0, 13.8);
-    return {x, y, z};
-}
-
-std::array<double, 3> xyz_to_linear_srgb(const std::array<double, 3>& c) {
-    return {3.2404542 * c[0] - 1.5371385 * c[1] - 0.4985314 * c[2],
-            -0.9692660 * c[0] + 1.8760108 * c[1] + 0.0415560 * c[2],
-            0.0556434 * c[0] - 0.2040259 * c[1] + 1.0572252 * c[2]};
 }
 
 PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx) {

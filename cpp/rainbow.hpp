@@ -11,7 +11,7 @@
 //     embedded into the library; the sampling's standard error is stored too.
 //  2. The renderer's table (rainbow_phase_table): per scene, interpolated in
 //     log rate, converted to linear sRGB through the CIE 1931 colour-matching
-//     functions (rainbow_cmf.inc) and resampled uniformly in angle: milliseconds.
+//     functions (airlight/colour.hpp) and resampled uniformly in angle: milliseconds.
 #pragma once
 
 #include <cstdint>

@@ -1,6 +1,7 @@
 // Stage 2 of the rainbow tables (cpp/rainbow.hpp): the renderer's linear-sRGB
 // table from the embedded spectral table, per scene.
 #include <algorithm>
+#include <array>
 #include <chrono>
 #include <cmath>
 #include <list>
@@ -8,6 +9,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "airlight/colour.hpp"
 #include "rainbow.hpp"
 #include "shader_cpp.hpp"
 
@@ -15,13 +17,6 @@ namespace airlight {
 
 // ---- Stage 2 ---------------------------------------------------------------
 namespace {
-struct CmfRow {
-    double wavelength, x, y, z, d65;
-};
-constexpr CmfRow kCmf[] = {
-#include "rainbow_cmf.inc"
-};
-
 // Node j's weight (hat function of the nodes' spacing) at a wavelength.
 double hat(double wavelength, double node, double spacing) {
     return std::max(0.0, 1.0 - std::abs(wavelength - node) / spacing);
@@ -36,18 +31,18 @@ void check_wavelength_count(int count) {
 // Channels R, G, B, then Y (luminance) per node, each normalised to sum 1.
 std::vector<double> spectral_weights(int count) {
     check_wavelength_count(count);
-    // XYZ to linear sRGB (IEC 61966-2-1).
-    const double m[3][3] = {{3.2406, -1.5372, -0.4986}, {-0.9689, 1.8758, 0.0415}, {0.0557, -0.2040, 1.0570}};
+    // Sums over the CIE tables' 1-nm rows within the table's 380-720 nm.
     const double spacing = 340.0 / (count - 1);
     std::vector<double> w(size_t(count) * 4, 0.0);
     for (int j = 0; j < count; ++j) {
         const double node = 380.0 + spacing * j;
-        for (const CmfRow& r : kCmf) {
-            const double h = hat(r.wavelength, node, spacing) * r.d65;
+        for (int nm = 380; nm <= 720; ++nm) {
+            const double h = hat(nm, node, spacing) * cie_d65(nm);
             if (h == 0.0) continue;
-            for (int c = 0; c < 3; ++c)
-                w[size_t(j) * 4 + size_t(c)] += h * (m[c][0] * r.x + m[c][1] * r.y + m[c][2] * r.z);
-            w[size_t(j) * 4 + 3] += h * r.y;
+            const std::array<double, 3> xyz = cie1931_xyz(nm);
+            const std::array<double, 3> rgb = xyz_to_linear_srgb(xyz);
+            for (int c = 0; c < 3; ++c) w[size_t(j) * 4 + size_t(c)] += h * rgb[size_t(c)];
+            w[size_t(j) * 4 + 3] += h * xyz[1];
         }
     }
     for (int c = 0; c < 4; ++c) {
@@ -134,11 +129,13 @@ const Table2D& rainbow_phase_table(double rate, int count) {
             for (int c = 0; c < 4; ++c) rgby[c] += w[size_t(j) * 4 + size_t(c)] * p;
         }
         // Colours outside the sRGB gamut (a channel below 0) are desaturated
-        // toward the luminance, keeping it, until the smallest channel is 0.
+        // toward the luminance, keeping it, until the smallest channel is 0
+        // (the max only removes rounding below 0).
         double s = 1.0;
         for (int c = 0; c < 3; ++c)
             if (rgby[c] < 0.0) s = std::min(s, rgby[3] / (rgby[3] - rgby[c]));
-        for (int c = 0; c < 3; ++c) t.texels[size_t(u) * 4 + size_t(c)] = float(rgby[3] + s * (rgby[c] - rgby[3]));
+        for (int c = 0; c < 3; ++c)
+            t.texels[size_t(u) * 4 + size_t(c)] = float(std::max(0.0, rgby[3] + s * (rgby[c] - rgby[3])));
         t.texels[size_t(u) * 4 + 3] = float(rgby[3]);
     }
     t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();

@@ -11,6 +11,7 @@
 #include <complex>
 #include <vector>
 
+#include "airlight/colour.hpp"
 #include "airlight/renderer.hpp"
 
 namespace airlight {
@@ -33,14 +34,6 @@ double pupil_diameter_from_luminance(double luminance_cd_m2);
 // full vertical field of view fov_y_deg over `height` rows:
 // 2 tan(fov_y / 2) / height (fov_y / height is a few percent smaller at wide fovs).
 double camera_pixel_angle(double fov_y_deg, int height);
-
-// CIE 1931 2-degree colour matching functions x, y, z at a wavelength (nm):
-// the multi-lobe Gaussian fit of Wyman, Sloan & Shirley 2013, "Simple
-// Analytic Approximations to the CIE XYZ Color Matching Functions", JCGT 2(2).
-std::array<double, 3> cie1931_xyz(double wavelength_nm);
-
-// Linear sRGB (D65) from CIE XYZ (IEC 61966-2-1 matrix).
-std::array<double, 3> xyz_to_linear_srgb(const std::array<double, 3>& xyz);
 
 struct GlareOptions {
     double pupil_diameter_mm = 4.0;  // [1, 9]

@@ -40,19 +40,19 @@ def test_water_refractive_index_agrees_with_an_independent_formula(wavelength):
 
 
 def test_cmf_table_is_the_cie_data_of_colour_science():
-    """cpp/rainbow_cmf.inc holds the CIE 1931 2-degree observer and D65 as the colour-science
-    package has them (tools/make_cmf_table.py)."""
+    """cpp/cie_tables.inc holds the CIE 1931 2-degree observer and D65 as the colour-science
+    package has them (tools/make_cmf_table.py), 380-780 nm."""
     colour = pytest.importorskip("colour", reason="colour-science is not installed")
     from pathlib import Path
     rows = []
-    text = (Path(__file__).resolve().parents[2] / "cpp" / "rainbow_cmf.inc").read_text()
+    text = (Path(__file__).resolve().parents[2] / "cpp" / "cie_tables.inc").read_text()
     for line in text.splitlines():
         if line.startswith("{"):
             rows.append([float(v) for v in line.strip("{},").split(",")])
     rows = np.array(rows)
     cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
     d65 = colour.SDS_ILLUMINANTS["D65"].copy().interpolate(colour.SpectralShape(300, 780, 1))
-    assert rows.shape == (341, 5)
+    assert rows.shape == (401, 5)
     for w, x, y, z, s in rows[::17]:
         assert np.allclose([x, y, z], cmfs[w], rtol=1e-6, atol=1e-9)
         assert s == pytest.approx(d65[w], rel=1e-6)
