@@ -232,3 +232,51 @@ def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str)
     left, right = int(np.argmax(near[:32])), 32 + int(np.argmax(near[32:]))
     assert 24 <= left <= 29 and 35 <= right <= 40, near.tolist()
     assert near[31:33].max() < 0.8 * min(near[left], near[right]), near.tolist()
+
+
+def test_demo_renders_the_rain_ends_sequence(tmp_path: Path, backend: str) -> None:
+    """The end of a shower (issue 7): one PNG per frame named by the drop density, falling
+    100-fold; the sun comes out over the first 40 % (the first frame, sunless, is the darkest
+    and has no bow); then the bow fades with the drops: the primary's ring (136.5-139.5 degrees
+    of scattering angle) is brighter than the dark band outside it (131-135) by 2 levels or more
+    in the second frame and by less than a third of that in the last."""
+    from reference import camera_rays
+
+    import airlight
+
+    path = Path(__file__).resolve().parents[2] / "scenes" / "rainbow_after_heavy_rain.json"
+    out = tmp_path / "frames"
+    proc = _demo("--scene", str(path), "--out", str(out), "--backend", backend, "--sequence", "rain-ends",
+                 "--frames", "5", "--width", "160", "--height", "100")
+    assert proc.returncode == 0, proc.stderr
+    names = sorted(p.name for p in out.iterdir())
+    assert names == [f"frame_{k:02d}_density_{d}.png"
+                     for k, d in enumerate(("0.0400", "0.0126", "0.0040", "0.0013", "0.0004"))]
+    frames = []
+    for name in names:
+        with Image.open(out / name) as png:
+            frames.append(np.asarray(png.convert("RGB")).astype(float).mean(axis=-1))
+    assert frames[0].mean() < 0.8 * frames[2].mean()
+    scene = airlight.preset("rainbow_after_heavy_rain")
+    _, dirs = camera_rays(scene["camera"], 160, 100)
+    el, az = np.radians(scene["sun"]["elevation"]), np.radians(scene["sun"]["azimuth"])
+    sun = np.array([np.sin(az) * np.cos(el), np.sin(el), -np.cos(az) * np.cos(el)])
+    angle = np.degrees(np.arccos(np.clip(dirs @ sun, -1.0, 1.0)))
+    sky = dirs[..., 1] > 0.05
+    primary, band = sky & (angle > 136.5) & (angle < 139.5), sky & (angle > 131.0) & (angle < 135.0)
+    contrast = [float(f[primary].mean() - f[band].mean()) for f in frames]
+    assert contrast[0] < 0.0 and contrast[1] > 2.0 and contrast[4] < contrast[1] / 3.0, contrast
+
+
+@pytest.mark.parametrize("edit, needle", [
+    (lambda s: s["atmosphere"].pop("rain"), "atmosphere.rain"),
+    (lambda s: (s.pop("sun"), s.update(sky={"model": "overcast", "zenith_radiance": [0.3] * 3})), "sun"),
+])
+def test_demo_rain_ends_needs_rain_and_a_sun(tmp_path: Path, edit, needle: str) -> None:
+    import airlight
+
+    scene = airlight.preset("rainbow_after_heavy_rain")
+    edit(scene)
+    path = _write_scene(tmp_path, scene)
+    proc = _demo("--scene", str(path), "--out", str(tmp_path / "frames"), "--sequence", "rain-ends")
+    _assert_one_line_error(proc, "rain-ends", needle)
