@@ -5,8 +5,8 @@ rate, how many wavelengths the colours need, and what interpolating in rate cost
         [--plot docs/images/rainbow_rates.png]
 
 1. Rain-rate dependence: per rate of the table, the primary bow's width and contrast at 550 nm,
-   the secondary's contrast, the separation of the colours, the RGB table's red and blue maxima
-   and saturation (bow_measures).
+   the secondary's contrast, the bow's saturation (excitation purity), the separation of the
+   colours, the RGB table's red and blue maxima and saturation (bow_measures).
 2. Colour convergence in wavelengths: the RGB table from 3, 5, 9 and 17 of the 33 spectral
    nodes against all 33, as the largest difference over 120-145 degrees relative to the luminance
    peak, and the error of the 33 themselves estimated from the rate of convergence.
@@ -49,10 +49,33 @@ def monochrome_bow(p: np.ndarray) -> tuple[float, float, float, float]:
     return at, width, peak / floor, secondary / floor
 
 
+def bow_purity(table: dict, k: int) -> float:
+    """Saturation as colour science defines it: the largest excitation purity (CIE 1931 xy,
+    D65 white; colour-science) of the bow's colours before any gamut mapping, over the angles
+    where the primary's luminance is above half its height over the dark band."""
+    import colour
+
+    cmfs = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"]
+    d65 = colour.SDS_ILLUMINANTS["D65"]
+    nm = np.arange(380, 721)
+    weights = np.array([cmfs[w] * d65[w] for w in nm])
+    white = weights.sum(axis=0)
+    phase = np.stack([spectral_bow(table, k, i) for i in range(len(table["wavelengths_nm"]))])  # (33, angles)
+    spectra = np.array([np.interp(nm, table["wavelengths_nm"], phase[:, j]) for j in range(phase.shape[1])])
+    xyz = spectra @ weights
+    y = xyz[:, 1]
+    floor = y[(BOW_ANGLES > 129.0) & (BOW_ANGLES < 136.0)].min()
+    primary = BOW_ANGLES > 134.0
+    bright = primary & (y > floor + 0.5 * (y[primary].max() - floor))
+    xy = xyz[bright, :2] / xyz[bright].sum(axis=1, keepdims=True)
+    return float(max(colour.excitation_purity(p, white[:2] / white.sum()) for p in xy))
+
+
 def bow_measures(table: dict, k: int) -> dict:
     """Rate k's bows: at 550 nm (node 16) the primary's width and contrast and the secondary's
-    contrast; the colours' separation (spread of the 33 wavelengths' primary maxima in units of
-    their mean width: below about 2 the colours overlap into a pale bow); and from the RGB table the
+    contrast; its saturation (bow_purity); the colours' separation (spread of the 33 wavelengths'
+    primary maxima in units of their mean width: below about 2 the colours overlap into a pale
+    bow); and from the RGB table the
     red and blue maxima and the largest saturation (max - min) / max (1 where the bow's colour
     leaves the sRGB gamut)."""
     rate = float(table["rates"][k])
@@ -66,7 +89,8 @@ def bow_measures(table: dict, k: int) -> dict:
     sat = (rgb.max(axis=1) - rgb.min(axis=1)) / np.maximum(rgb.max(axis=1), 1e-30)
     return {"rate": rate, "width_deg": width, "contrast": contrast, "secondary_contrast": secondary,
             "colour_separation": (max(peaks) - min(peaks)) / float(np.mean([m[1] for m in per_node])),
-            "red_max_deg": red, "blue_max_deg": blue, "rgb_saturation": float(sat[in_primary].max())}
+            "purity": bow_purity(table, k), "red_max_deg": red, "blue_max_deg": blue,
+            "rgb_saturation": float(sat[in_primary].max())}
 
 
 def main() -> None:
@@ -82,15 +106,15 @@ def main() -> None:
 
     say("# Rainbow table measurements (benchmarks/rainbow_analysis.py)\n")
     say("## 1. Rain-rate dependence (Marshall-Palmer drops of 0.1-3.5 mm, seen through the sun's disc)\n")
-    say("| rate (mm/h) | width at 550 nm (deg) | primary / band | secondary / band | colour separation | "
-        "red max (deg) | blue max (deg) | RGB saturation |")
-    say("|---|---|---|---|---|---|---|---|")
+    say("| rate (mm/h) | width at 550 nm (deg) | primary / band | secondary / band | purity | "
+        "colour separation | red max (deg) | blue max (deg) | RGB saturation |")
+    say("|---|---|---|---|---|---|---|---|---|")
     t = _core.rainbow_spectral_table()
     measures = [bow_measures(t, k) for k in range(len(t["rates"]))]
     for m in measures:
         say(f"| {m['rate']:g} | {m['width_deg']:.2f} | {m['contrast']:.1f} | {m['secondary_contrast']:.1f} | "
-            f"{m['colour_separation']:.2f} | {m['red_max_deg']:.2f} | {m['blue_max_deg']:.2f} | "
-            f"{m['rgb_saturation']:.3f} |")
+            f"{m['purity']:.3f} | {m['colour_separation']:.2f} | {m['red_max_deg']:.2f} | "
+            f"{m['blue_max_deg']:.2f} | {m['rgb_saturation']:.3f} |")
 
     say("\n## 2. Colour convergence in wavelengths (RGB table over 120-145 degrees against the one from "
         "all 33 "
@@ -143,10 +167,10 @@ def main() -> None:
         ax.semilogx(rates, [m["width_deg"] for m in measures], "o-", label="primary width at 550 nm (deg)")
         ax.semilogx(rates, [m["colour_separation"] for m in measures], "^-", label="colour separation")
         ax2 = ax.twinx()
-        ax2.semilogx(rates, [m["contrast"] for m in measures], "s--", color="C2", label="primary / band")
+        ax2.semilogx(rates, [m["purity"] for m in measures], "s--", color="C2", label="saturation (purity)")
         ax.set_xlabel("rain rate (mm/h)")
         ax.set_ylabel("width (deg), separation")
-        ax2.set_ylabel("primary / dark band at 550 nm")
+        ax2.set_ylabel("largest excitation purity in the primary")
         ax.legend(loc="upper left", fontsize=8)
         ax2.legend(loc="lower right", fontsize=8)
         ax.set_title("primary bow against rain rate")

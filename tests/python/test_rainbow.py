@@ -263,14 +263,36 @@ def bow_chroma(rate: float) -> float:
     return float((max(peaks) - min(peaks)) / np.mean(widths))
 
 
+def bow_purity(rate: float) -> float:
+    """The bow's saturation: the largest excitation purity (CIE 1931 xy against D65, computed by
+    colour-science) of the spectral table's colours where the primary is above half its height
+    over the dark band, before any gamut mapping."""
+    colour = pytest.importorskip("colour", reason="colour-science is not installed")
+    t = spectral()
+    cmfs, d65 = colour.MSDS_CMFS["CIE 1931 2 Degree Standard Observer"], colour.SDS_ILLUMINANTS["D65"]
+    nm = np.arange(380, 721)
+    weights = np.array([cmfs[w] * d65[w] for w in nm])
+    angles = np.linspace(120.0, 146.0, 521)
+    phase = np.stack([np.interp(angles, t["angles_deg"], spectral_phase(rate, i)) for i in range(33)])
+    xyz = np.stack([np.interp(nm, t["wavelengths_nm"], phase[:, j]) for j in range(len(angles))]) @ weights
+    floor = xyz[(angles > 129.0) & (angles < 136.0), 1].min()
+    primary = angles > 134.0
+    bright = primary & (xyz[:, 1] > floor + 0.5 * (xyz[primary, 1].max() - floor))
+    white = weights.sum(axis=0)
+    return max(float(colour.excitation_purity(c[:2] / c.sum(), white[:2] / white.sum())) for c in xyz[bright])
+
+
 def test_light_rain_gives_wider_paler_bows():
     """From heavy to light rain the primary bow widens (its width at one wavelength) and loses
-    contrast and colour (the separation of the colours' maxima in units of their widths).
+    saturation (excitation purity), contrast and colour separation (the spread of the colours'
+    maxima in units of their widths).
     docs/rainbow.md plots it (benchmarks/rainbow_analysis.py)."""
     rates = [819.2, 102.4, 25.6, 6.4, 1.6, 0.4, 0.1]
     widths, contrasts = zip(*[monochrome_bow(r) for r in rates])
     chroma = [bow_chroma(r) for r in rates]
+    purity = [bow_purity(r) for r in rates]
     assert all(b >= a for a, b in zip(widths, widths[1:])) and widths[-1] > 1.3 * widths[0], widths
+    assert all(b < a for a, b in zip(purity, purity[1:])) and purity[-1] < purity[0] - 0.1, purity
     assert all(b < a for a, b in zip(contrasts, contrasts[1:])), contrasts
     assert all(b < a for a, b in zip(chroma, chroma[1:])), chroma
 
