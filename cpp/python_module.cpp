@@ -333,19 +333,32 @@ PYBIND11_MODULE(_core, m) {
         py::arg("n_radial") = 12);
     m.def(
         "mie_size_average_phase",
-        [](double rate, double wavelength_nm, const std::vector<double>& angles_deg, int n_sizes) {
-            if (!(rate > 0.0) || !std::isfinite(rate)) throw py::value_error("rate: must be a positive number (mm/h)");
+        // rate > 0: Marshall-Palmer drops of 0.1-3.5 mm; rate 0: N(D) ~
+        // exp(-slope D) on [d_min, d_max] (mm).
+        [](double rate, double wavelength_nm, const std::vector<double>& angles_deg, int n_sizes, double slope,
+           double d_min, double d_max) {
+            airlight::DropSizes sizes{slope, d_min, d_max};
+            if (rate != 0.0) {
+                if (!(rate > 0.0) || !std::isfinite(rate))
+                    throw py::value_error("rate: must be a positive number (mm/h), or 0 with slope, d_min, d_max");
+                sizes = airlight::DropSizes{airlight::marshall_palmer_slope(rate)};
+            }
+            if (!(sizes.slope_per_mm >= 0.0 && sizes.slope_per_mm < 1e6))
+                throw py::value_error("slope: must be in [0, 1e6)");
+            if (!(sizes.d_min_mm >= 1e-4 && sizes.d_min_mm < sizes.d_max_mm && sizes.d_max_mm <= 10.0))
+                throw py::value_error("d_min, d_max: need 1e-4 <= d_min < d_max <= 10 (mm)");
             if (!(wavelength_nm >= 200.0 && wavelength_nm <= 2000.0))
                 throw py::value_error("wavelength_nm: must be in [200, 2000]");
             if (n_sizes < 1 || n_sizes > 100000) throw py::value_error("n_sizes: must be in [1, 100000]");
             std::vector<double> p;
             {
                 py::gil_scoped_release release;
-                p = airlight::mie_size_average_phase(rate, wavelength_nm, angles_deg, n_sizes);
+                p = airlight::mie_size_average_phase(sizes, wavelength_nm, angles_deg, n_sizes);
             }
             return py::array_t<double>(py::ssize_t(p.size()), p.data());
         },
-        py::arg("rate"), py::arg("wavelength_nm"), py::arg("angles_deg"), py::arg("n_sizes"));
+        py::arg("rate"), py::arg("wavelength_nm"), py::arg("angles_deg"), py::arg("n_sizes"), py::arg("slope") = 0.0,
+        py::arg("d_min") = airlight::RAINDROP_D_MIN_MM, py::arg("d_max") = airlight::RAINDROP_D_MAX_MM);
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

@@ -272,13 +272,13 @@ std::vector<double> mie_sun_disc_phase(double refractive_index, double diameter_
     return p;
 }
 
-std::vector<double> mie_size_average_phase(double rate_mm_per_h, double wavelength_nm,
+std::vector<double> mie_size_average_phase(const DropSizes& sizes, double wavelength_nm,
                                            const std::vector<double>& angles_deg, int n_sizes) {
-    // Midpoint rule in log D over [D_MIN, D_MAX] with the Marshall-Palmer
-    // weight N(D) dD = N0 exp(-Lambda D) D dlnD (N0 cancels in the ratio);
-    // the sizes are shared out between threads, each with its own sums.
-    const double slope = marshall_palmer_slope(rate_mm_per_h);
-    const double lo = std::log(RAINDROP_D_MIN_MM), hi = std::log(RAINDROP_D_MAX_MM);
+    // Midpoint rule in log D over [d_min, d_max] with the weight
+    // N(D) dD = N0 exp(-slope D) D dlnD (N0 cancels in the ratio); the sizes
+    // are shared out between threads, each with its own sums.
+    const double slope = sizes.slope_per_mm;
+    const double lo = std::log(sizes.d_min_mm), hi = std::log(sizes.d_max_mm);
     std::vector<double> theta(angles_deg.size());
     for (size_t a = 0; a < theta.size(); ++a) theta[a] = angles_deg[a] * kDeg;
     const unsigned threads = std::max(1u, std::min(std::thread::hardware_concurrency(), unsigned(n_sizes)));

@@ -86,10 +86,15 @@ const RainbowSpectralTable& rainbow_spectral_table();
 std::vector<double> mie_sun_disc_phase(double refractive_index, double diameter_mm, double wavelength_nm,
                                        const std::vector<double>& angles_deg, int n_radial = 12);
 
-// The size-averaged phase function at a point (no sun disc) by a
-// deterministic rule, independent of the table's Monte Carlo: midpoint rule
-// with n_sizes diameters evenly spaced in log D (tests and docs/rainbow.md).
-std::vector<double> mie_size_average_phase(double rate_mm_per_h, double wavelength_nm,
+// The phase function of drops with N(D) ~ exp(-slope D) on [d_min, d_max]
+// (mm; Marshall-Palmer: slope = marshall_palmer_slope(rate) on [RAINDROP_D_MIN_MM,
+// RAINDROP_D_MAX_MM]) at a point (no sun disc), by a deterministic rule
+// independent of the table's Monte Carlo: midpoint rule with n_sizes
+// diameters evenly spaced in log D (tests and docs/rainbow.md).
+struct DropSizes {
+    double slope_per_mm = 0.0, d_min_mm = RAINDROP_D_MIN_MM, d_max_mm = RAINDROP_D_MAX_MM;
+};
+std::vector<double> mie_size_average_phase(const DropSizes& sizes, double wavelength_nm,
                                            const std::vector<double>& angles_deg, int n_sizes);
 
 // ---- Stage 2: the renderer's table ----------------------------------------

@@ -297,6 +297,32 @@ def test_light_rain_gives_wider_paler_bows():
     assert all(b < a for a, b in zip(chroma, chroma[1:])), chroma
 
 
+def small_drop_bow(diameter: float, wavelength: float) -> tuple[float, float]:
+    """Drops within a factor 1.25 of one diameter (mm) through the sun's disc: the primary's
+    maximum (degrees) and the secondary's contrast over the dark band."""
+    offsets, weights = disc_profile_rule()
+    angles = np.arange(110.0, 160.01, 0.1)
+    points = (angles[:, None] + offsets[None, :]).ravel().tolist()
+    p = _core.mie_size_average_phase(0.0, wavelength, points, 200, 0.0, diameter / 1.25, diameter * 1.25)
+    p = p.reshape(len(angles), -1) @ weights
+    band = p[(angles > 129.0) & (angles < 136.0)].min()
+    primary = (angles > 134.0) & (angles < 150.0)
+    secondary = p[(angles > 120.0) & (angles < 131.0)].max()
+    return float(angles[primary][np.argmax(p[primary])]), float(secondary / band)
+
+
+def test_small_drops_lose_the_secondary_and_the_colours():
+    """MODELS.md section 4: small drops give pale bows and the secondary fades away. Below the
+    rain's sizes (drops of 10 um, fog; not rendered): the secondary is gone (its maximum within 25 %
+    of the band's floor, against 7 times it at 0.2 mm), and the primary is white (its blue and red
+    maxima within 0.3 degree, against 1 degree apart at 0.2 mm) and moved inward (fogbow)."""
+    fog = {w: small_drop_bow(0.01, w) for w in (450.0, 650.0)}
+    rain = {w: small_drop_bow(0.2, w) for w in (450.0, 650.0)}
+    assert fog[450.0][1] < 1.25 and rain[450.0][1] > 5.0, (fog, rain)
+    assert abs(fog[450.0][0] - fog[650.0][0]) < 0.3 and rain[450.0][0] - rain[650.0][0] > 0.8, (fog, rain)
+    assert fog[650.0][0] > rain[650.0][0] + 3.0
+
+
 def test_rainbow_table_is_continuous_and_non_negative():
     """No NaN, no negative channel, and no jump between neighbouring texels larger than the bows'
     own steepest slopes allow (the spectral grid's steps at 3, 118 and 146 degrees do not show)."""
