@@ -2,7 +2,9 @@
 // writes it for embedding: build/cpp/make_rainbow_table --out data/rainbow_phase.bin
 // Prints, per rate, the largest Monte-Carlo standard error in the bow region.
 // --merge FILE adds the wavelengths of an existing table (same rates, angles
-// and samples) to the ones computed, for refining the wavelength grid.
+// and samples) to the ones computed, for refining the wavelength grid;
+// --angles LO HI computes only the grid's angles in [LO, HI] and takes the
+// others from the --merge table (same wavelengths), for refining the angles.
 // --renormalise FILE rescales an existing table's forward aureole in place
 // (normalise_rainbow_aureole; tables computed since do it themselves).
 #include <algorithm>
@@ -25,6 +27,42 @@ airlight::RainbowSpectralTable read_table(const std::string& path) {
     if (!in) throw std::runtime_error("cannot read");
     const std::vector<char> bytes((std::istreambuf_iterator<char>(in)), std::istreambuf_iterator<char>());
     return airlight::parse_rainbow_table(bytes);
+}
+
+// The computed table's angles (all within [lo, hi]) completed with the other
+// angles of this build's grid from an earlier table of the same wavelengths.
+airlight::RainbowSpectralTable with_angles_from(const airlight::RainbowSpectralTable& computed,
+                                                const airlight::RainbowSpectralTable& earlier, double lo, double hi) {
+    if (computed.wavelengths_nm != earlier.wavelengths_nm || computed.rates != earlier.rates ||
+        computed.samples_per_wavelength != earlier.samples_per_wavelength)
+        throw std::runtime_error("wavelengths, rates or samples differ from the computed table's");
+    airlight::RainbowSpectralTable m = computed;
+    m.angles_deg = airlight::rainbow_angles_deg();
+    const size_t rows = m.rates.size() * m.wavelengths_nm.size(), na = m.angles_deg.size();
+    m.phase.assign(rows * na, 0.0f);
+    m.rel_error.assign(rows * na, 0.0f);
+    size_t from_computed = 0;
+    for (size_t a = 0; a < na; ++a) {
+        const double deg = m.angles_deg[a];
+        const airlight::RainbowSpectralTable* src = &computed;
+        size_t at = from_computed;
+        if (deg >= lo && deg <= hi) {
+            ++from_computed;
+        } else {
+            const auto it = std::find(earlier.angles_deg.begin(), earlier.angles_deg.end(), deg);
+            if (it == earlier.angles_deg.end())
+                throw std::runtime_error("the earlier table lacks the angle " + std::to_string(deg));
+            src = &earlier;
+            at = size_t(it - earlier.angles_deg.begin());
+        }
+        const size_t src_na = src->angles_deg.size();
+        for (size_t r = 0; r < rows; ++r) {
+            m.phase[r * na + a] = src->phase[r * src_na + at];
+            m.rel_error[r * na + a] = src->rel_error[r * src_na + at];
+        }
+    }
+    airlight::normalise_rainbow_aureole(m);
+    return m;
 }
 
 // The union of two tables' wavelengths, in increasing order.
@@ -84,10 +122,13 @@ int main(int argc, char** argv) {
             renormalise = value();
         else if (a == "--merge")
             merge = value();
-        else {
+        else if (a == "--angles") {
+            sampling.angle_min_deg = std::stod(value());
+            sampling.angle_max_deg = std::stod(value());
+        } else {
             std::fprintf(stderr,
                          "make_rainbow_table: unknown option %s (--samples N --seed S --threads T "
-                         "--wavelength I (repeatable) --out FILE --merge FILE | --renormalise FILE)\n",
+                         "--wavelength I (repeatable) --angles LO HI --out FILE --merge FILE | --renormalise FILE)\n",
                          a.c_str());
             return 2;
         }
@@ -120,7 +161,9 @@ int main(int argc, char** argv) {
     const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     if (!merge.empty()) {
         try {
-            t = merged(t, earlier);
+            const bool some_angles = sampling.angle_min_deg > 0.0 || sampling.angle_max_deg < 180.0;
+            t = some_angles ? with_angles_from(t, earlier, sampling.angle_min_deg, sampling.angle_max_deg)
+                            : merged(t, earlier);
         } catch (const std::exception& e) {
             std::fprintf(stderr, "make_rainbow_table: %s: %s\n", merge.c_str(), e.what());
             return 1;
@@ -132,17 +175,15 @@ int main(int argc, char** argv) {
     for (size_t k = 0; k < t.rates.size(); ++k) {
         double worst = 0.0, at_peak = 0.0;
         for (size_t w = 0; w < nw; ++w) {
-            double peak = 0.0;
+            size_t peak = 0;  // the primary's maximum at this wavelength
             for (size_t a = 0; a < na; ++a) {
                 const double deg = t.angles_deg[a];
                 if (deg < 120.0 || deg > 145.0) continue;
                 const size_t i = (k * nw + w) * na + a;
                 worst = std::max(worst, double(t.rel_error[i]));
-                if (deg > 134.0 && t.phase[i] > peak) {
-                    peak = t.phase[i];
-                    at_peak = std::max(at_peak, double(t.rel_error[i]));
-                }
+                if (deg > 134.0 && (peak == 0 || t.phase[i] > t.phase[peak])) peak = i;
             }
+            if (peak != 0) at_peak = std::max(at_peak, double(t.rel_error[peak]));
         }
         std::printf("%8.1f | %.4f | %.4f\n", t.rates[k], worst, at_peak);
     }

@@ -34,7 +34,8 @@ double rainbow_wavelength_nm(int i);
 constexpr int RAINBOW_RATES = 14;
 double rainbow_rate(int k);
 // Scattering angles in degrees: every 0.05 degree in [0, 3] (the aureole) and
-// [118, 146] (both bows and the dark band), every 0.5 degree elsewhere.
+// [118, 146] (both bows and the dark band) and [178, 180] (the glory), every
+// 0.5 degree elsewhere.
 std::vector<double> rainbow_angles_deg();
 
 // Drop diameters in mm (MODELS.md section 3: raindrops of 0.1 to 3.5 mm).
@@ -68,11 +69,14 @@ struct RainbowSampling {
     std::uint64_t seed = 1;
     int threads = 0;               // 0: all hardware threads
     std::vector<int> wavelengths;  // indices to compute (empty: all)
+    // Only the grid's angles in this range (degrees), for refining a table.
+    double angle_min_deg = 0.0, angle_max_deg = 180.0;
 };
 RainbowSpectralTable compute_rainbow_spectral_table(const RainbowSampling& sampling);
 // Rescales the forward aureole (below 1 degree) of each rate and wavelength so
 // that the phase integrates to exactly 1 over the sphere: the sampling's noise
 // in that integral is almost all there (compute_rainbow_spectral_table calls it).
+// A table that does not span 0-180 degrees is left as it is.
 void normalise_rainbow_aureole(RainbowSpectralTable& table);
 
 std::vector<char> serialize_rainbow_table(const RainbowSpectralTable& table);

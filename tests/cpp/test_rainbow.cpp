@@ -79,6 +79,30 @@ void check_aureole_normalisation() {
     CHECK(forward_dimmed);
 }
 
+// Part of the angle grid (for refining a table) computes only those angles,
+// finite and positive, and is not rescaled (it does not span the sphere).
+void check_partial_angle_range() {
+    RainbowSampling s;
+    s.samples_per_wavelength = 64;
+    s.wavelengths = {16};
+    s.angle_min_deg = 178.0;
+    s.angle_max_deg = 180.0;
+    const RainbowSpectralTable t = compute_rainbow_spectral_table(s);
+    CHECK(t.angles_deg.size() == 41 && t.angles_deg.front() == 178.0 && t.angles_deg.back() == 180.0);
+    bool finite_positive = true;
+    for (float p : t.phase) finite_positive = finite_positive && std::isfinite(p) && p > 0.0f;
+    CHECK(finite_positive);
+    s.angle_min_deg = 180.5;
+    s.angle_max_deg = 181.0;
+    bool threw = false;
+    try {
+        compute_rainbow_spectral_table(s);
+    } catch (const std::invalid_argument&) {
+        threw = true;
+    }
+    CHECK(threw);
+}
+
 void check_colour_weights() {
     for (int count : {3, 5, 9, 17}) {
         const std::vector<float> w = rainbow_rgb_weights(count);
@@ -139,6 +163,7 @@ int main() {
     check_embedded_table();
     check_file_format();
     check_aureole_normalisation();
+    check_partial_angle_range();
     check_colour_weights();
     check_rgb_table_and_cache();
     check_features();

@@ -136,6 +136,7 @@ def test_spectral_table_grids():
     a = t["angles_deg"]
     assert a[0] == 0.0 and a[-1] == 180.0 and np.all(np.diff(a) > 0)
     assert np.diff(a[bow_mask(t)]).max() <= 0.05 + 1e-9
+    assert np.diff(a[a >= 178.0]).max() <= 0.05 + 1e-9  # the glory
     assert np.all(np.isfinite(t["phase"])) and np.all(t["phase"] > 0.0)
 
 
@@ -325,13 +326,14 @@ def test_small_drops_lose_the_secondary_and_the_colours():
 
 def test_rainbow_table_is_continuous_and_non_negative():
     """No NaN, no negative channel, and no jump between neighbouring texels larger than the bows'
-    own steepest slopes allow (the spectral grid's steps at 3, 118 and 146 degrees do not show)."""
+    own steepest slopes allow (the spectral grid's steps at 3, 118, 146 and 178 degrees do not
+    show)."""
     for rate in (0.1, 0.3, 25.0, 1000.0):
         p = airlight.rainbow_phase(rate).astype(float)
         assert np.all(np.isfinite(p)) and p.min() >= 0.0
         rel = np.abs(np.diff(p, axis=0)) / np.maximum(np.maximum(p[1:], p[:-1]), 1e-12)
         grid = np.linspace(0.0, 180.0, 3601)[1:]
-        for edge in (3.0, 118.0, 146.0):
+        for edge in (3.0, 118.0, 146.0, 178.0):
             near = np.abs(grid - edge) < 0.2
             around = (np.abs(grid - edge) >= 0.2) & (np.abs(grid - edge) < 1.5)
             assert rel[near].max() <= 1.5 * rel[around].max() + 1e-3, (rate, edge, rel[near].max())
