@@ -170,6 +170,20 @@ def sweep(renderer: airlight.Renderer, scene: dict, pixels, expected: np.ndarray
     return rows
 
 
+def sweep_table(rows: dict, baseline: float | None = None) -> list[str]:
+    """The sweep's rows as a Markdown table; with ``baseline`` (the frame time without the
+    atmosphere) also the atmosphere's part of each frame."""
+    part = " atmosphere part (ms) |" if baseline is not None else ""
+    out = [f"| method | parameter | frame (ms) |{part} max error | 95th pct error |",
+           "|---|---|---|" + ("---|" if baseline is not None else "") + "---|---|"]
+    for method, label in (("analytic", "segments"), ("march", "steps")):
+        for m in rows[method]:
+            cell = f" {(m['seconds'] - baseline) * 1e3:.1f} |" if baseline is not None else ""
+            out.append(f"| {method} | {label} {m['param']} | {m['seconds'] * 1e3:.1f} |{cell} "
+                       f"{m['error']:.2e} | {m['error95']:.2e} |")
+    return out
+
+
 def write_outputs(lines: list[str], results: dict, scenes, backends, out: Path | None,
                   plot: Path | None) -> None:
     """The table as text, and the time-against-error plot (one panel a scene) with its data."""
@@ -248,12 +262,8 @@ def main() -> None:
                 rows = sweep(r, scene, pixels, expected, args.segments, args.steps, args.gl_max_steps)
             results.setdefault(name, {})[backend] = {"no_atmosphere_seconds": t_bare, **rows}
             say(f"\n### {backend}: frame without the atmosphere {t_bare * 1e3:.1f} ms\n")
-            say("| method | parameter | frame (ms) | atmosphere part (ms) | max error | 95th pct error |")
-            say("|---|---|---|---|---|---|")
-            for method, label in (("analytic", "segments"), ("march", "steps")):
-                for m in rows[method]:
-                    say(f"| {method} | {label} {m['param']} | {m['seconds'] * 1e3:.1f} | "
-                        f"{(m['seconds'] - t_bare) * 1e3:.1f} | {m['error']:.2e} | {m['error95']:.2e} |")
+            for line in sweep_table(rows, t_bare):
+                say(line)
             ups = ", ".join(f"{t:.1%}: {speedup(rows['analytic'], rows['march'], t)}" for t in TARGETS)
             say(f"\nspeed-up of the scattering volumes over marching at equal error (whole frames): {ups}")
             part, part_m = ([{"error": m["error"], "seconds": max(m["seconds"] - t_bare, 1e-4)}

@@ -40,7 +40,7 @@ sys.path.insert(0, str(ROOT / "benchmarks"))
 
 import daytime_reference as ref  # noqa: E402
 import reference  # noqa: E402
-from bench_daytime import speedup, sweep, sweep_arguments, timed, write_outputs  # noqa: E402
+from bench_daytime import speedup, sweep, sweep_arguments, sweep_table, timed, write_outputs  # noqa: E402
 from daytime_scenes import reference_atmosphere, reference_sky  # noqa: E402
 
 SCENES = ("rainbow_after_heavy_rain", "rainbow_after_light_rain")
@@ -132,12 +132,8 @@ def main() -> None:
             results.setdefault(name, {})[backend] = {"rainbow_seconds": t_mie, "hg_seconds": t_hg, **rows}
             say(f"\n### {backend}: frame with the rainbow term {t_mie * 1e3:.1f} ms, without (HG rain) "
                 f"{t_hg * 1e3:.1f} ms (ratio {t_mie / t_hg:.2f})\n")
-            say("| method | parameter | frame (ms) | max error | 95th pct error |")
-            say("|---|---|---|---|---|")
-            for method, label in (("analytic", "segments"), ("march", "steps")):
-                for m in rows[method]:
-                    say(f"| {method} | {label} {m['param']} | {m['seconds'] * 1e3:.1f} | {m['error']:.2e} | "
-                        f"{m['error95']:.2e} |")
+            for line in sweep_table(rows):
+                say(line)
             ups = ", ".join(f"{t:.1%}: {speedup(rows['analytic'], rows['march'], t)}" for t in TARGETS)
             say(f"\nspeed-up of the scattering volumes over marching at equal error: {ups}")
     write_outputs(lines, results, SCENES, backends, args.out, args.plot)

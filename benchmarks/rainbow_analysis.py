@@ -24,18 +24,26 @@ rate, how many wavelengths the colours need, and what interpolating in rate cost
    rates and wavelengths; linear interpolation's error scales as the square of the spacing, so
    the table's own is about a quarter of this. And the same for the renderer's RGB table in the
    bows, relative to the primary's peak luminance.
+6. Accuracy against independent references and the rendered geometry (the numbers behind the
+   acceptance tests of tests/python/test_rainbow.py, which assert their bounds): one drop through
+   the sun's disc against the numpy Mie series; the size-averaged table against the deterministic
+   size quadrature; the table's sampling error by region; its normalisation; the renderer's
+   table's per-channel normalisation; and the bows' angles in a rendered column, both backends.
 """
 
 from __future__ import annotations
 
 import argparse
 import json
+import sys
 from pathlib import Path
 
 import numpy as np
 
 import airlight
 from airlight import _core
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests" / "python"))
 
 GRID = np.linspace(0.0, 180.0, 3601)
 LUMA = np.array([0.2126, 0.7152, 0.0722])
@@ -142,6 +150,81 @@ def halving_errors(table: dict, lo: float, hi: float) -> tuple[float, float, flo
     return float(rel.max()), float(np.percentile(rel, 99)), float(np.median(rel))
 
 
+def accuracy_section(t: dict, say) -> None:
+    """Section 6 (see the module's docstring)."""
+    import test_rainbow as tr  # the acceptance tests' own helpers and references
+
+    say("\n## 6. Against independent references, and the rendered geometry\n")
+    angles = np.arange(120.0, 145.01, 0.25)
+    say("One drop through the sun's disc, library (Mie series, 2-D disc rule) against numpy "
+        "(mie_reference.py, 1-D disc profile rule), 120-145 degrees:\n")
+    say("| diameter (mm) | wavelength (nm) | largest relative difference |")
+    say("|---|---|---|")
+    for d, w in ((0.1, 450.0), (0.1, 650.0), (0.3, 450.0), (0.3, 650.0), (1.0, 550.0)):
+        n = _core.water_refractive_index(w)
+        ours = _core.mie_sun_disc_phase(n, d, w, angles.tolist(), 16)
+        theirs = tr.numpy_disc_phase(n, d, w, angles)
+        say(f"| {d:g} | {w:g} | {np.max(np.abs(ours - theirs) / theirs):.4f} |")
+    say("\nThe embedded table at 25.6 mm/h against 1600 sizes evenly spaced in log D (midpoint rule) "
+        "through the disc profile, 120-145 degrees every 0.5:\n")
+    say("| wavelength (nm) | largest relative difference | median |")
+    say("|---|---|---|")
+    k = int(np.argmin(np.abs(t["rates"] - 25.6)))
+    coarse = np.arange(120.0, 145.01, 0.5)
+    offsets, weights = tr.disc_profile_rule()
+    points = (coarse[:, None] + offsets[None, :]).ravel().tolist()
+    for node in (4, 16, 28):
+        wavelength = float(t["wavelengths_nm"][node])
+        point_phase = _core.mie_size_average_phase(25.6, wavelength, points, 1600)
+        theirs = point_phase.reshape(len(coarse), -1) @ weights
+        ours = np.interp(coarse, t["angles_deg"], t["phase"][k, node].astype(float))
+        rel = np.abs(ours - theirs) / theirs
+        say(f"| {wavelength:g} | {rel.max():.4f} | {np.median(rel):.4f} |")
+
+    a, err, phase = t["angles_deg"], t["rel_error"], t["phase"]
+    say("\nStored sampling error (relative standard error) by region:\n")
+    say("| angles (deg) | largest | median |")
+    say("|---|---|---|")
+    for lo, hi in ((0.0, 0.3), (0.3, 1.0), (1.0, 118.0), (120.0, 145.0), (146.0, 180.0)):
+        m = (a >= lo) & (a <= hi)
+        say(f"| {lo:g}-{hi:g} | {err[:, :, m].max():.4f} | {np.median(err[:, :, m]):.4f} |")
+    bows = (a >= 120.0) & (a <= 145.0)
+    worst = np.unravel_index(np.argmax(err[:, :, bows]), err[:, :, bows].shape)
+    prim = (a > 134.0) & (a < 145.0)
+    at_max = [float(err[r, w][prim][np.argmax(phase[r, w][prim])]) for r in range(len(t["rates"]))
+              for w in range(len(t["wavelengths_nm"]))]
+    say(f"\nlargest in 120-145 degrees at {a[bows][worst[2]]:.2f} degrees ({t['rates'][worst[0]]:g} mm/h); "
+        f"at each rate's and wavelength's primary maximum: {min(at_max):.4f}-{max(at_max):.4f}")
+    total = tr.sphere_integral(a, phase)
+    beyond = tr.sphere_integral(a[a >= 3.0], phase[..., a >= 3.0])
+    say(f"integral over the sphere: {total.min():.6f}-{total.max():.6f}; beyond 3 degrees: "
+        f"{beyond.min():.4f}-{beyond.max():.4f}")
+    grid = np.linspace(0.0, 180.0, 3601)
+    channel_totals = np.concatenate([tr.sphere_integral(grid, airlight.rainbow_phase(r).T)
+                                     for r in (0.1, 1.0, 25.0, 819.2)])
+    say(f"renderer's RGB table, each channel over the sphere (0.1-819.2 mm/h): "
+        f"{channel_totals.min():.5f}-{channel_totals.max():.5f}")
+
+    say("\nRendered column through the antisolar point (sun 20 degrees up, 25 mm/h; tests' bow_scene):\n")
+    say("| backend | red max | blue max | secondary (luminance) | secondary red / blue | band / inside |")
+    say("|---|---|---|---|---|---|")
+    scene = tr.bow_scene()
+    angle = tr.scattering_angles(scene)
+    for backend in airlight.available_backends():
+        with airlight.Renderer(backend) as r:
+            img = r.render(scene)[:, 0, :].astype(float)
+
+        def arg_max(lo: float, hi: float, values: np.ndarray) -> float:
+            m = (angle > lo) & (angle < hi)
+            return float(angle[m][np.argmax(values[m])])
+
+        lum = img @ LUMA
+        band = lum[(angle > 131.0) & (angle < 135.5)].mean() / lum[(angle > 140.5) & (angle < 145.0)].mean()
+        say(f"| {backend} | {arg_max(134, 142, img[:, 0]):.2f} | {arg_max(134, 142, img[:, 2]):.2f} | "
+            f"{arg_max(126, 131, lum):.2f} | {arg_max(124, 132, img[:, 0]):.2f} / "
+            f"{arg_max(124, 132, img[:, 2]):.2f} | {band:.3f} |")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--out", type=Path)
@@ -222,6 +305,8 @@ def main() -> None:
         worst_rgb = max(worst_rgb, float(np.abs(estimate - rgb[dropped]).max()) / peak)
     say(f"\nRGB in the bows (118-146 degrees) at twice the spacing: largest channel error "
         f"{worst_rgb:.4f} of the primary's peak luminance (over all rates)")
+
+    accuracy_section(t, say)
 
     if args.out:
         args.out.parent.mkdir(parents=True, exist_ok=True)
