@@ -205,6 +205,17 @@ def accuracy_section(t: dict, say) -> None:
     say(f"renderer's RGB table, each channel over the sphere (0.1-819.2 mm/h): "
         f"{channel_totals.min():.5f}-{channel_totals.max():.5f}")
 
+    def descartes_primary(n: float) -> float:
+        """Scattering angle (degrees) of the primary's minimum deviation (geometric optics)."""
+        i = np.arccos(np.sqrt((n * n - 1.0) / 3.0))
+        r = np.arcsin(np.sin(i) / n)
+        return float(np.degrees(np.pi + 2.0 * i - 4.0 * r))
+
+    qf, dm = _core.water_refractive_index(700.0), tr.daimon_masumura_water_index(700.0)
+    say(f"\nwater at 700 nm: Quan & Fry {qf:.5f}, Daimon & Masumura {dm:.5f}, MODELS.md 1.3311; "
+        f"Descartes primary at {descartes_primary(qf):.3f} / {descartes_primary(dm):.3f} / "
+        f"{descartes_primary(1.3311):.3f} degrees")
+
     say("\nRendered column through the antisolar point (sun 20 degrees up, 25 mm/h; tests' bow_scene):\n")
     say("| backend | red max | blue max | secondary (luminance) | secondary red / blue | band / inside |")
     say("|---|---|---|---|---|---|")

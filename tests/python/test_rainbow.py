@@ -34,7 +34,7 @@ def daimon_masumura_water_index(wavelength_nm: float) -> float:
 @pytest.mark.parametrize("wavelength", [400.0, 450.0, 500.0, 550.0, 589.0, 650.0, 700.0])
 def test_water_refractive_index_agrees_with_an_independent_formula(wavelength):
     """Quan & Fry (20 C) against Daimon & Masumura (21.5 C): within 5e-4 over 400-700 nm (the
-    temperatures differ by 1.5 C, about 1.5e-4). A bow moves by about 0.15 degree per 1e-3."""
+    temperatures differ by 1.5 C, about 1.5e-4)."""
     assert _core.water_refractive_index(wavelength) == pytest.approx(
         daimon_masumura_water_index(wavelength), abs=5e-4)
 
