@@ -14,10 +14,10 @@ namespace airlight {
 
 struct GlareKernel;  // include/airlight/glare.hpp
 
-// One run of the GL display pass (issue 8). cpp/display_stage.cpp resolves
+// One run of the GL display pass (issue 8). effects/display/display_stage.cpp resolves
 // the exposure and decides whether glare is needed (the same decisions as on
 // the CPU); the GPU does the glare convolution, the tone curve and the sRGB
-// encoding (shaders/display.glsl's display_pixel).
+// encoding (effects/display/display.glsl's display_pixel).
 struct GlDisplayJob {
     const Image* linear = nullptr;       // linear radiance, row 0 on top
     float exposure = 1.0f;               // resolved exposure, >= 0
@@ -41,6 +41,8 @@ struct GlDisplayOutput {
 class CpuBackend {
 public:
     void render(const FrameData& data, Image& out);
+    // The outputs of data.grid_passes alone, in order (tests).
+    std::vector<Table2D> grid_passes(const FrameData& data);
     int threads = 0;  // 0: std::thread::hardware_concurrency()
 };
 
@@ -63,7 +65,8 @@ private:
     std::unique_ptr<State> state_;
 };
 
-// The complete GLSL fragment shader source for one feature set.
-std::string fragment_shader_source(const shader::Features& features);
+// The complete GLSL fragment shader source for one feature set: the shading
+// pass's (grid_pass_slot -1) or that of the grid pass filling that table slot.
+std::string fragment_shader_source(const shader::Features& features, int grid_pass_slot = -1);
 
 }  // namespace airlight

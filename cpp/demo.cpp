@@ -185,7 +185,7 @@ void print_report(const std::string& path, const airlight::Image& image, airligh
     std::printf(")\n");
 }
 
-// The headlight experiment of the source paper (MODELS.md section 5): a car's
+// The headlight experiment of the source paper (effects/display/physics.md): a car's
 // two headlights (spots 1.5 m apart, 0.65 m high, aimed at the camera)
 // approach along the road from `from` to `to` metres (distances spaced
 // evenly in log), the camera (1.2 m high) tracking the midpoint between them.
@@ -230,7 +230,7 @@ int run_sequence(airlight::Scene scene, const Options& o, airlight::Backend back
     return 0;
 }
 
-// The end of a rain (MODELS.md section 4): over the frames the clouds part
+// The end of a rain (effects/rainbow/physics.md): over the frames the clouds part
 // (the sun's irradiance rises from 0 to the scene's along a smoothstep over the
 // first 40 % of the sequence) while the drops fall out (the rain's
 // density_scale decays from the scene's value by a factor 100, evenly in

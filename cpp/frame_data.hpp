@@ -1,6 +1,7 @@
 // Scene -> the flat arrays both backends consume (shaders/layout.glsl).
 #pragma once
 
+#include <array>
 #include <vector>
 
 #include "airlight/scene.hpp"
@@ -9,6 +10,17 @@
 
 namespace airlight {
 
+// A grid pass to run before the shading pass (an effect's EFFECT_PASSES): it
+// fills table slot `slot` (shader::TABLE_*) with width x height texels of
+// `channels` (1 or 4) floats from the GLSL function <name>_pass(x, y); the
+// backend owns the result for the frame.
+struct GridPassJob {
+    int slot = 0;
+    int width = 0;
+    int height = 0;
+    int channels = 1;
+};
+
 struct FrameData {
     shader::FrameUniforms frame{};
     std::vector<shader::PointLightGpu> point_lights;
@@ -16,22 +28,25 @@ struct FrameData {
     std::vector<shader::BvhNodeGpu> bvh_nodes;  // over the bounded surfaces (boxes, spheres)
     std::vector<shader::SpotLightGpu> spot_lights;
     shader::Features features;
-    // Tables the shader variant reads (null when the scene does not need them:
-    // they are then never built).
-    const Table2D* airlight_tail = nullptr;
-    const Table2D* surface_glow = nullptr;
-    const Table2D* spot_moments = nullptr;
-    // Per phase lobe (anisotropic media; docs/phase_table.md).
-    const Table2D* phase_moments[2] = {nullptr, nullptr};
-    const Table2D* phase_glow[2] = {nullptr, nullptr};
-    // The sky-phase table (sky.glsl; cpp/sky.hpp): only for a sky that lights
-    // an atmosphere (then with its columns) or surfaces (C = 0 only when
-    // there is no atmosphere).
-    const Table2D* sky_table = nullptr;
-    // The rainbow table (cpp/rainbow.hpp): only for rain lit by the sun with
-    // the "mie" phase.
-    const Table2D* rainbow_table = nullptr;
+    bool scattering = false;  // the homogeneous medium scatters light (some sigma_s > 0)
+    // The tables the shader variant reads, by slot (shader::TABLE_*, the
+    // effects' EFFECT_TABLES); null where the scene does not need one: it is
+    // then never built.
+    std::array<const Table2D*, shader::TABLE_COUNT> tables{};
+    // Grid passes to run first, in order (a pass may read the tables of those before it).
+    std::vector<GridPassJob> grid_passes;
 };
+
+// Each effect's part of the frame (registry: EFFECT_FRAME, EFFECT_FRAME_TABLES):
+// pack_<name>_frame fills its data and features after the core's part, in
+// registry order; pick_<name>_tables then chooses its tables, once every
+// effect's features are known.
+#define AIRLIGHT_X(effect) void pack_##effect##_frame(const Scene& scene, FrameData& data);
+AIRLIGHT_FRAME_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
+#define AIRLIGHT_X(effect) void pick_##effect##_tables(const Scene& scene, FrameData& data);
+AIRLIGHT_FRAME_TABLE_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
 
 // Builds the per-frame data: camera basis, medium coefficients, lights and
 // surfaces, the feature set that selects the shader variant, and the tables

@@ -16,8 +16,11 @@
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
+#include "airlight_tables.hpp"
+#include "phase_tables.hpp"
 #include "rainbow.hpp"
 #include "scene_json.hpp"
+#include "spot_tables.hpp"
 #include "tables.hpp"
 
 namespace py = pybind11;
@@ -260,7 +263,7 @@ PYBIND11_MODULE(_core, m) {
         }
         return out;
     });
-    // Rainbow tables (cpp/rainbow.hpp): exposed for tests and benchmarks.
+    // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",
         [](double rate, int wavelengths) {

@@ -1,6 +1,8 @@
 #!/usr/bin/env bash
 # Builds everything and runs every test, C++ (ctest) and Python (pytest).
 # Calls scripts/setup.sh first, so it also works on a fresh clone.
+#   bash scripts/test.sh           # the full suite (what CI runs)
+#   bash scripts/test.sh --quick   # the quick tier for development: the tests not marked slow
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -8,7 +10,11 @@ export PATH="$PWD/.venv/bin:$PATH"
 cmake -S . -B build/cpp -G Ninja -DAIRLIGHT_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/cpp
 ctest --test-dir build/cpp --output-on-failure
-ruff check python tests benchmarks examples
+ruff check python tests benchmarks examples effects conftest.py
 mypy python/airlight
-clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp
-python -m pytest tests/python -q
+clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp effects/*/*.cpp effects/*/*.hpp effects/*/tests/*.cpp
+if [ "${1:-}" = "--quick" ]; then
+    python -m pytest -q -m "not slow"
+else
+    python -m pytest -q
+fi

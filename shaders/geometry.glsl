@@ -4,8 +4,8 @@
 
 // Unit direction of the ray through the centre of pixel (x, row), row 0 on top.
 vec3 camera_ray_direction(int x, int row) {
-    float width = float(frame.film_counts.x);
-    float height = float(frame.film_counts.y);
+    float width = float(frame.film_width);
+    float height = float(frame.film_height);
     float sx = 2.0f * (float(x) + 0.5f) / width - 1.0f;
     float sy = 1.0f - 2.0f * (float(row) + 0.5f) / height;
     return normalize(vec3(frame.camera_forward) + sx * vec3(frame.camera_right) +
@@ -85,7 +85,7 @@ float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT
     float best = t_max;
     hit_index = -1;
     hit_normal = vec3(0.0f, 1.0f, 0.0f);
-    for (int i = 0; i < frame.geometry_counts.x; ++i) {
+    for (int i = 0; i < frame.plane_count; ++i) {
         vec3 n;
         float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
         if (t < best) {
@@ -95,7 +95,7 @@ float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT
             if (any_hit) return best;
         }
     }
-    if (frame.geometry_counts.y == 0) return hit_index >= 0 ? best : NO_HIT;
+    if (frame.bvh_node_count == 0) return hit_index >= 0 ? best : NO_HIT;
     vec3 inv_dir = vec3(safe_inverse(dir.x), safe_inverse(dir.y), safe_inverse(dir.z));
     int stack[BVH_STACK_SIZE];
     int top = 0;
@@ -150,4 +150,13 @@ float intersect_lamp(PointLightGpu light, vec3 origin, vec3 dir) {
     float disc = r * r - dot(perp, perp);
     if (disc < 0.0f) return NO_HIT;
     return -b - sqrt(disc);
+}
+
+// Offset that lifts a hit point off its surface before tracing shadow rays:
+// a multiple of the float rounding of p (relative to its coordinates and to
+// the camera's, which p was computed from), so it works at any scale.
+float surface_offset(vec3 p) {
+    vec3 o = vec3(frame.camera_position);
+    float scale = max(max(abs(p.x), abs(p.y)), abs(p.z)) + max(max(abs(o.x), abs(o.y)), abs(o.z));
+    return 1.0e-5f * scale + 1.0e-30f;
 }

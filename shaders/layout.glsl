@@ -8,7 +8,7 @@ struct PhaseLobeGpu {
     vec4 info;   // x: g, y: 1 for Rayleigh, z: glow row-warp floor K_min, w: weight in the mixture
 };
 
-// The sky dome and the sun (MODELS.md section 3; sky.glsl).
+// The sky dome and the sun (effects/daytime/physics.md; sky.glsl).
 struct SkyGpu {
     vec4 zenith_radiance;  // rgb: Lz; w: model (SKY_NONE, SKY_OVERCAST, SKY_CIE)
     vec4 gradation;        // x: a, y: b, z: 1 / (phi(0) f(Z_s)) (CIE normaliser)
@@ -30,6 +30,29 @@ struct SpeciesGpu {
     vec4 inv_scales;   // 1 / scale height of each piece (0: constant, < 0: growing)
 };
 
+// Buffer bindings of the frame's data (resources.glsl on GL; the CPU reads FrameData).
+CONST int BINDING_FRAME = 0;        // uniform block: FrameUniforms
+CONST int BINDING_POINT_LIGHTS = 1;  // storage blocks: PointLightGpu[], SurfaceGpu[], BvhNodeGpu[], SpotLightGpu[]
+CONST int BINDING_SURFACES = 2;
+CONST int BINDING_BVH_NODES = 3;
+CONST int BINDING_SPOT_LIGHTS = 4;
+
+// The atmosphere's particle species, FrameUniforms::species's indices.
+CONST int SPECIES_MOLECULES = 0;
+CONST int SPECIES_AEROSOL = 1;
+CONST int SPECIES_RAIN = 2;
+CONST int SPECIES_COUNT = 3;
+
+// The sun's shadow map (effects/sun_shadow_map): an orthographic grid seen
+// along the sunlight; texel (i, j) is centred at origin + (i + 1/2) w axis_u +
+// (j + 1/2) w axis_v on the map's top plane (w: the texel size).
+struct SunShadowMapGpu {
+    vec4 origin;  // xyz: the grid's corner on the top plane, w: texel size (m)
+    vec4 axis_u;  // xyz: unit axis across the sunlight, w: texels along it
+    vec4 axis_v;  // xyz: the other unit axis, w: texels along it
+    vec4 depth;   // x: depth (m) of the casters' box below the top plane, y: float32 rounding bias (m)
+};
+
 // Per-frame constants (std140 uniform block on the GPU).
 struct FrameUniforms {
     vec4 camera_position;  // xyz: pinhole position
@@ -39,32 +62,51 @@ struct FrameUniforms {
     vec4 sigma_t;          // rgb: medium extinction (1/m); 0 in clear air
     vec4 sigma_s;          // rgb: medium scattering (1/m) = albedo * sigma_t
     vec4 background;       // rgb: radiance of escaping rays, before attenuation
-    ivec4 film_counts;     // x: width, y: height, z: point lights, w: surfaces
-    vec4 quality;          // x: cull fraction, y: march steps, z: march far distance (m), w: spot glow samples (spot_surface_glow)
-    ivec4 geometry_counts; // x: planes (surfaces [0, x)), y: BVH nodes over the other surfaces,
-                           // zw: pixel origin of the tile being drawn (GL backend; 0 on the CPU)
-    ivec4 light_counts;    // x: spot lights, y: phase lobes (0: isotropic medium)
-    vec4 phase_bounds;     // x: int_0^{pi/2} P dt (airlight culling; pi/2 isotropic), y: max G (glow culling)
+    // Scalars in groups of four (std140 packs them as C++ does; a vec4 after a full group stays aligned).
+    int film_width;           // pixels
+    int film_height;
+    int point_light_count;    // point_lights[0, n)
+    int surface_count;        // surfaces[0, n): the planes, then the bounded surfaces in BVH leaf order
+    int plane_count;          // surfaces[0, n) are planes (tested one by one)
+    int bvh_node_count;       // BVH nodes over the bounded surfaces (0: none)
+    int tile_origin_x;        // pixel origin of the tile being drawn (GL backend; 0 on the CPU)
+    int tile_origin_y;
+    int spot_light_count;     // spot_lights[0, n)
+    int phase_lobe_count;     // lobes of the medium's phase function (0: isotropic)
+    int unused_int0;
+    int unused_int1;
+    float cull_fraction;      // contributions provably below this fraction of the pixel are skipped
+    float march_steps;        // brute-force ray marching (quality.airlight "march"): steps per ray
+    float march_far;          // ... and the distance (m) where escaping rays are cut
+    float spot_glow_samples;  // quadrature nodes of a spot's surface glow (spot_surface_glow)
+    float phase_airlight_bound;  // int_0^{pi/2} P dt (airlight culling; pi/2 isotropic)
+    float phase_glow_bound;      // max G (glow culling)
+    float unused_float0;
+    float unused_float1;
     PhaseLobeGpu phase_lobe0;
     PhaseLobeGpu phase_lobe1;
     SkyGpu sky;
-    SpeciesGpu species[3];  // molecules, aerosol, rain (phase.z = 0 when absent)
-    vec4 atmosphere;        // x: top altitude (empty above), y: altitude levels, z: sky table columns (1: C = 0 only), w: its azimuth blocks
+    SpeciesGpu species[SPECIES_COUNT];  // SPECIES_MOLECULES, SPECIES_AEROSOL, SPECIES_RAIN (phase.z = 0 when absent)
+    float atmosphere_top;            // top altitude (m): empty above
+    float altitude_level_count;      // altitude_levels in use
+    float sky_table_columns;         // columns of the sky-phase table (1: C = 0 only)
+    float sky_table_azimuth_blocks;  // its blocks of rows by azimuth (1: no sun)
     vec4 altitude_levels[ATMOSPHERE_MAX_LEVELS / 4];  // sorted level altitudes, 4 per vec4 (sky.glsl)
+    SunShadowMapGpu sun_shadow_map;
 };
 
-// An isotropic point lamp (MODELS.md section 1): a sphere of radius r emitting
+// An isotropic point lamp (effects/lamp_airlight/physics.md): a sphere of radius r emitting
 // radiant intensity I (W/sr), hence radiance I / (pi r^2) on its disc.
 struct PointLightGpu {
     vec4 position_radius;  // xyz: centre, w: radius (m)
     vec4 intensity;        // rgb: W/sr
 };
 
-// A spotlight (MODELS.md section 2): profile I(theta) = I0 [(1 - q)(cos theta -
+// A spotlight (effects/spotlights/physics.md): profile I(theta) = I0 [(1 - q)(cos theta -
 // cos A)/(1 - cos A) + q] for theta <= A, theta measured from the axis; a
 // sphere of radius r like a point lamp. Quantities that lose precision in
 // float32 (position relative to the camera, sin^2 A, 1 - cos A) are formed in
-// double on the CPU (docs/spot_table.md, section 4).
+// double on the CPU (effects/spotlights/docs/spot_table.md, section 4).
 struct SpotLightGpu {
     vec4 relative_position_radius;  // xyz: S - camera position, w: radius (m)
     vec4 world_position;            // xyz: S

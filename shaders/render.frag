@@ -4,6 +4,6 @@
 layout(location = 0) out vec4 out_radiance;
 
 void main() {
-    ivec2 pixel = ivec2(gl_FragCoord.xy) + frame.geometry_counts.zw;
+    ivec2 pixel = ivec2(gl_FragCoord.xy) + ivec2(frame.tile_origin_x, frame.tile_origin_y);
     out_radiance = vec4(render_pixel(pixel.x, pixel.y), 1.0f);
 }

@@ -14,18 +14,9 @@ vec3 transmittance(float t) {
     return exp(-sigma_t * t);
 }
 
-// Offset that lifts a hit point off its surface before tracing shadow rays:
-// a multiple of the float rounding of p (relative to its coordinates and to
-// the camera's, which p was computed from), so it works at any scale.
-float surface_offset(vec3 p) {
-    vec3 o = vec3(frame.camera_position);
-    float scale = max(max(abs(p.x), abs(p.y)), abs(p.z)) + max(max(abs(o.x), abs(o.y)), abs(o.z));
-    return 1.0e-5f * scale + 1.0e-30f;
-}
-
 // Irradiance from the light of a lamp of intensity I scattered once on its way
 // to a surface point at distance dist: sigma_s I / (2 pi D) e^{-T} G(T, theta_s)
-// (MODELS.md section 1, G0 term), D held at the lamp radius inside the lamp.
+// (effects/lamp_airlight/physics.md section 3), D held at the lamp radius inside the lamp.
 vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos_theta_s) {
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * intensity / (2.0f * PI * max(dist, radius));
@@ -43,7 +34,7 @@ vec3 surface_glow_irradiance(vec3 intensity, float dist, float radius, float cos
 // a spot of axial intensity I, whose profile is <= 1) at distance dist:
 // sigma_s I e^{-T} G / (2 pi D) with G <= SURFACE_GLOW_G_BOUND, for culling.
 vec3 surface_glow_bound(vec3 intensity, vec3 attenuation, float dist, float radius) {
-    return vec3(frame.sigma_s) * intensity * attenuation * (frame.phase_bounds.y / (2.0f * PI * max(dist, radius)));
+    return vec3(frame.sigma_s) * intensity * attenuation * (frame.phase_glow_bound / (2.0f * PI * max(dist, radius)));
 }
 
 // Irradiance (W/m^2) at a surface point p with unit normal n from the point
@@ -78,7 +69,7 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
 
 // Irradiance at p (normal n) from the spotlights: the profile in the direction
 // of p, inverse-square falloff, Lambert's cosine, attenuation and hard shadows
-// (MODELS.md section 2); plus, in a scattering medium, the light each spot
+// (effects/spotlights/physics.md); plus, in a scattering medium, the light each spot
 // scatters once on the way (spot_surface_glow, not shadowed), bounded for
 // culling by the glow of a point lamp of intensity I0 (the profile is <= 1).
 vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
@@ -100,7 +91,7 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
         if (profile <= 0.0f) direct = vec3(0.0f);
         vec3 glow_bound = HAS_SPOT_AIRLIGHT ? surface_glow_bound(intensity, attenuation, dist, radius) : vec3(0.0f);
         if (negligible(direct + glow_bound, irradiance + so_far)) continue;
-        if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.quality.w));
+        if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.spot_glow_samples));
         if (profile <= 0.0f) continue;
         if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
         irradiance += direct;
@@ -109,7 +100,7 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
 }
 
 // Airlight of point light `light` over the visible part [0, x_end] of the
-// view ray (MODELS.md section 1): sigma_s I / (2 pi h) times the segment
+// view ray (effects/lamp_airlight/physics.md): sigma_s I / (2 pi h) times the segment
 // integral of airlight.glsl. A camera inside the lamp's sphere sees fog from
 // where the ray leaves the sphere. Skipped when its bound
 // sigma_s I e^{-sigma_t (D - r)} (pi / 2) / (2 pi h) is negligible against
@@ -125,7 +116,7 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     if (x0 >= x_end) return vec3(0.0f);
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
-    if (negligible(scale * frame.phase_bounds.x * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
+    if (negligible(scale * frame.phase_airlight_bound * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
     if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, origin, dir, x0, x_end);
     // The scale goes into the exponent (airlight_tail); channels without
     // scattering or light have none.
@@ -163,8 +154,8 @@ vec3 lamp_film_square(vec3 rel, float r) {
     if (z <= r || d <= r) return vec3(0.0f, 0.0f, NO_HIT);
     float sx = dot(rel, right) / (z * dot(right, right));
     float sy = dot(rel, up) / (z * dot(up, up));
-    float width = float(frame.film_counts.x);
-    float height = float(frame.film_counts.y);
+    float width = float(frame.film_width);
+    float height = float(frame.film_height);
     float pixel = 2.0f * length(up) / height;  // pixel side on the plane at distance 1
     float cos_theta = z / d;
     float disc_radius = r / (d * cos_theta * sqrt(cos_theta));  // equal projected area
@@ -301,9 +292,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal);
         if (HAS_SPOT_LIGHTS && !black) irradiance += spot_light_irradiance(p, normal, irradiance);
         if (HAS_SKY && !black) irradiance += sky_irradiance(p, normal);
-        if (HAS_SUN && !black && dot(normal, vec3(frame.sky.sun_direction)) > 0.0f &&
-            !(HAS_SURFACES && segment_occluded(p + surface_offset(p) * normal, vec3(frame.sky.sun_direction), NO_HIT))) {
-            irradiance += sun_irradiance(p, normal);
+        if (HAS_SUN && !black && dot(normal, vec3(frame.sky.sun_direction)) > 0.0f) {
+            float visible = sun_visibility(p, normal);  // effects/sun_shadow_map
+            if (visible > 0.0f) irradiance += visible * sun_irradiance(p, normal);
         }
         radiance = albedo / PI * irradiance;
     } else {
@@ -320,7 +311,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         vec3 inscatter;
         vec3 through_atmosphere;
         if (SKY_MARCH) {
-            atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.quality.y), inscatter,
+            atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter,
                                         through_atmosphere);
         } else {
             atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, through_atmosphere);

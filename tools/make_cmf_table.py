@@ -1,10 +1,10 @@
 """Writes cpp/cie_tables.inc: the CIE 1931 2-degree colour-matching functions
 and the CIE D65 illuminant, 380-780 nm every 1 nm, from the colour-science
 package's copies of the CIE tables. cpp/colour.cpp serves them to the glare
-kernels (cpp/glare.cpp) and the rainbow's colours (cpp/rainbow_rgb.cpp).
+kernels (effects/display/glare.cpp) and the rainbow's colours (effects/rainbow/rainbow_rgb.cpp).
 
 Run: .venv/bin/python tools/make_cmf_table.py  (needs `pip install colour-science`)
-tests/python/test_rainbow.py checks the committed file against the package.
+effects/rainbow/tests/test_rainbow.py checks the committed file against the package.
 """
 
 from __future__ import annotations

@@ -1,7 +1,7 @@
 // Display stage (issue 8): linear radiance -> 8-bit sRGB as a person would see
 // it: exposure (manual, or automatic from the image's log-average luminance),
 // a tone curve on luminance, then the sRGB OETF. The per-pixel math is
-// shaders/display.glsl, shared with the GL display pass; this is the CPU
+// effects/display/display.glsl, shared with the GL display pass; this is the CPU
 // implementation, multithreaded over rows.
 #pragma once
 
@@ -92,7 +92,7 @@ private:
     std::vector<double> gain_envelope_, bend_envelope_;  // G, H
 };
 
-// How the glare of one display run is done (plan_glare; docs/glare.md
+// How the glare of one display run is done (plan_glare; effects/display/docs/glare.md
 // "Skipping what does not show").
 //
 // The exact glare is K * v (K the kernel, centre weight k_c). Split v into a

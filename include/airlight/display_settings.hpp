@@ -13,7 +13,7 @@ enum class ExposureMode {
     automatic,  // exposure = key / log-average luminance (auto_exposure)
 };
 
-// The tone curves of shaders/display.glsl (their ids there: TONE_*).
+// The tone curves of effects/display/display.glsl (their ids there: TONE_*).
 enum class ToneCurve {
     linear,    // L / W, clipped
     loglog,    // the source paper's double logarithm: ln(1 + ln(1 + L)) / ln(1 + ln(1 + W))
@@ -21,7 +21,7 @@ enum class ToneCurve {
     filmic,    // ACES fit of Narkowicz (2015), white point W
 };
 
-// The eye's diffraction glare (include/airlight/glare.hpp, docs/glare.md).
+// The eye's diffraction glare (include/airlight/glare.hpp, effects/display/docs/glare.md).
 struct GlareSettings {
     bool enabled = false;
     // Pupil diameter in mm, in [1, 9]; empty: from the adaptation luminance

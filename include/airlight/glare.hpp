@@ -1,10 +1,10 @@
-// Physically based glare of the eye (issue 8, MODELS.md section 5): the
+// Physically based glare of the eye (issue 8, effects/display/physics.md): the
 // Fraunhofer point spread function of the pupil (optionally obstructed by
 // eyelashes), per wavelength, combined through the CIE 1931 colour matching
 // functions into one kernel per linear sRGB channel, resampled onto the
 // image's angular pixel grid by integrating the PSF over each pixel, and
 // applied to linear radiance by FFT convolution. Derivation and measured
-// numbers: docs/glare.md.
+// numbers: effects/display/docs/glare.md.
 #pragma once
 
 #include <array>

@@ -31,12 +31,12 @@ enum class PhaseType { isotropic, hg, rayleigh, hg2 };
 
 // The medium's phase function p(cos theta), normalised to 1 over the sphere,
 // theta the angle between the light's directions before and after scattering
-// (MODELS.md conventions):
+// (docs/conventions.md):
 //   isotropic  1 / (4 pi)
 //   hg         Henyey-Greenstein with asymmetry g in (-1, 1)
 //   rayleigh   3 / (16 pi) (1 + cos^2 theta)
 //   hg2        forward_weight HG(forward_g) + (1 - forward_weight) HG(backward_g)
-// Rendering clamps |g| to PHASE_G_LIMIT (docs/phase_table.md, section 0).
+// Rendering clamps |g| to PHASE_G_LIMIT (effects/phase/docs/phase_table.md, section 0).
 struct Phase {
     PhaseType type = PhaseType::isotropic;
     float g = 0.0f;               // hg
@@ -45,7 +45,7 @@ struct Phase {
     float forward_weight = 1.0f;  // hg2
 };
 
-// Homogeneous participating medium filling all space (MODELS.md conventions):
+// Homogeneous participating medium filling all space (docs/conventions.md):
 // sigma_t extinction in 1/m, albedo = sigma_s / sigma_t.
 struct Medium {
     Rgb sigma_t{0.0f};
@@ -64,7 +64,7 @@ struct PointLight {
     float radius = 0.05f;
 };
 
-// Spot light (MODELS.md section 2): a lamp at `position` shining along the unit
+// Spot light (effects/spotlights/physics.md): a lamp at `position` shining along the unit
 // `direction` with intensity (W/sr) I0 on the axis and, at angle theta from it,
 //   I(theta) = I0 [(1 - edge) (cos theta - cos A) / (1 - cos A) + edge]
 // for theta <= A = cone_angle_degrees (the half-angle, in (0, 90]), else 0.
@@ -95,8 +95,8 @@ struct Surface {
     Rgb albedo{0.5f};
 };
 
-// ---- Daytime: sky dome, sun and a height-varying atmosphere (MODELS.md
-// section 3; issue 6; docs/daytime.md). Altitude is y in metres above the
+// ---- Daytime: sky dome, sun and a height-varying atmosphere (effects/daytime/physics.md;
+// issue 6; effects/daytime/docs/daytime.md). Altitude is y in metres above the
 // ground plane y = 0; the atmosphere exists for y >= 0.
 
 enum class SkyModel {
@@ -125,7 +125,7 @@ struct Sun {
 };
 
 // Air molecules: Rayleigh scattering, sea-level coefficients times
-// density_scale, scale height 8 km (MODELS.md section 3).
+// density_scale, scale height 8 km (effects/daytime/physics.md).
 struct Molecules {
     bool present = false;
     float density_scale = 1.0f;
@@ -135,7 +135,7 @@ struct Molecules {
 // extinction at the ground given either by the visibility (Koschmieder,
 // 3.912 / V for the clear air, molecules included) or directly by the
 // coefficient; exponential decay with scale_height up to the minimum at
-// 2250 m, a 25 % rise to 3250 m, decay above (MODELS.md section 3).
+// 2250 m, a 25 % rise to 3250 m, decay above (effects/daytime/physics.md).
 struct Aerosol {
     bool present = false;
     float visibility = 0.0f;   // m; > 0 when given
@@ -149,10 +149,10 @@ struct Aerosol {
 // extinction is pi N0 / Lambda^3 (extinction efficiency 2) times
 // density_scale; constant density from the ground to `top` (the cloud base,
 // m); Henyey-Greenstein g of large drops.
-// How rain scatters the sun (MODELS.md section 4): "mie", the drops'
+// How rain scatters the sun (effects/rainbow/physics.md): "mie", the drops'
 // Lorenz-Mie phase function averaged over the rate's drop sizes, per
-// wavelength (rainbows; cpp/rainbow.hpp); or "hg", Henyey-Greenstein with g.
-// Sky light is always scattered with HG g (the sky is smooth; docs/rainbow.md).
+// wavelength (rainbows; effects/rainbow/rainbow.hpp); or "hg", Henyey-Greenstein with g.
+// Sky light is always scattered with HG g (the sky is smooth; effects/rainbow/docs/rainbow.md).
 enum class RainPhase { mie, hg };
 
 struct Rain {
@@ -171,7 +171,7 @@ struct Atmosphere {
     bool any() const { return molecules.present || aerosol.present || rain.present; }
 };
 
-// How the airlight is computed (MODELS.md section 1).
+// How the airlight is computed (effects/lamp_airlight/physics.md).
 enum class AirlightMethod {
     analytic,  // the table method: exact up to the tables' measured error
     march,     // brute-force ray marching, for benchmarks and comparison
@@ -182,21 +182,25 @@ struct Quality {
     AirlightMethod airlight = AirlightMethod::analytic;
     int march_steps = 64;  // midpoint-rule steps per light and view ray, for "march"
     // A light is skipped wherever a bound proves its contribution to a pixel
-    // below cull_fraction x the scene's reference radiance (docs/culling.md);
+    // below cull_fraction x the scene's reference radiance (effects/lamp_airlight/docs/culling.md);
     // 0 disables culling.
     float cull_fraction = 1e-5f;
     // Directions per azimuth ring and rings of the quadrature over a spot's
     // beam that gives the light it scatters onto surfaces (a multiple of 4 in
-    // [4, 64]; docs/spot_table.md section 9 measures its error).
+    // [4, 64]; effects/spotlights/docs/spot_table.md section 9 measures its error).
     int spot_glow_samples = 12;
-    // Accuracy knob of the daytime scattering volumes (MODELS.md section 3):
+    // Accuracy knob of the daytime scattering volumes (effects/daytime/physics.md):
     // the number of altitude levels that split view rays through the
-    // atmosphere (docs/daytime.md measures error against it), in [2, 64].
+    // atmosphere (effects/daytime/docs/daytime.md measures error against it), in [2, 64].
     int sky_segments = 16;
     // Wavelength nodes (3, 5, 9, 17 or 33, 380-720 nm) of the rainbow's
-    // spectral phase function turned into RGB (docs/rainbow.md measures the
+    // spectral phase function turned into RGB (effects/rainbow/docs/rainbow.md measures the
     // colour error of fewer).
     int rainbow_wavelengths = 33;
+    // The sun's shadows on surfaces: 0 traces a shadow ray per point (exact);
+    // N in [16, 4096] looks them up in a shadow map of N texels along its
+    // longer side, filled by a grid pass (effects/sun_shadow_map/physics.md).
+    int sun_shadow_map = 0;
 };
 
 struct Scene {

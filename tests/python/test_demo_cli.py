@@ -208,6 +208,7 @@ def test_demo_bad_display_object_in_the_scene_names_the_field(tmp_path: Path, sc
                            "display.glare.pupil_diameter")
 
 
+@pytest.mark.slow
 def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str) -> None:
     """The headlight experiment: one PNG per distance, named by frame and distance; at 2 km
     the two headlights are one spot in the middle, at 20 m two spots either side of a
@@ -234,6 +235,7 @@ def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str)
     assert near[31:33].max() < 0.8 * min(near[left], near[right]), near.tolist()
 
 
+@pytest.mark.slow
 def test_demo_renders_the_rain_ends_sequence(tmp_path: Path, backend: str) -> None:
     """The end of a shower (issue 7): one PNG per frame named by the drop density, falling
     100-fold; the sun comes out over the first 40 % (the first frame, sunless, is the darkest

@@ -85,6 +85,7 @@ def fog_with(phase: dict) -> dict:
 HG = {"type": "hg", "g": 0.85}
 
 
+@pytest.mark.slow
 def test_anisotropic_fog_builds_only_its_lobes_tables():
     """A phase function builds per-lobe slices instead of the isotropic tables: the moment
     slice for lamps' and spots' airlight, the glow slice only where surfaces receive a
@@ -105,6 +106,7 @@ def test_anisotropic_fog_builds_only_its_lobes_tables():
     assert stats["phase_glow g=0.85"]["bytes"] == 256 * 128 * 4
 
 
+@pytest.mark.slow
 def test_two_lobes_rayleigh_and_g0_tables():
     """HG2 builds one slice per lobe, Rayleigh its own, and HG with g = 0 the isotropic tables."""
     hg2 = {"type": "hg2", "forward_g": 0.85, "backward_g": -0.3, "forward_weight": 0.9}

@@ -385,6 +385,7 @@ def _containers(node: Any, out: list) -> list:
     return out
 
 
+@pytest.mark.slow
 @settings(max_examples=300, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(data=st.data())
 def test_garbage_anywhere_in_a_scene_raises_only_type_or_value_errors(data) -> None:

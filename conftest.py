@@ -1,0 +1,95 @@
+"""Shared fixtures of every test (the core's in tests/python, each effect's in
+effects/<name>/tests): backend parametrisation, cached renderers, a small base
+scene. The test folders are put on sys.path here, so that a test imports the
+reference implementations beside it (and the core's helpers) by name."""
+
+from __future__ import annotations
+
+import copy
+import sys
+from pathlib import Path
+from typing import Any, Callable
+
+import pytest
+
+import airlight
+
+ROOT = Path(__file__).resolve().parent
+TEST_DIRS = [ROOT / "tests" / "python", *sorted(ROOT.glob("effects/*/tests"))]
+for _dir in TEST_DIRS:
+    if str(_dir) not in sys.path:
+        sys.path.insert(0, str(_dir))
+
+BACKENDS = ("cpu", "gl")
+
+
+def skip_unless_backend_available(backend: str) -> None:
+    """Skips the calling test when ``backend`` cannot run on this machine."""
+    if backend == "gl":
+        reason = airlight.gl_unavailable_reason()
+        if reason is not None:
+            pytest.skip(f"GL backend unavailable: {reason}")
+
+
+@pytest.fixture(params=BACKENDS)
+def backend(request: pytest.FixtureRequest) -> str:
+    """Each test using it runs once per backend; "gl" is skipped where GL cannot run."""
+    skip_unless_backend_available(request.param)
+    return request.param
+
+
+@pytest.fixture(scope="session")
+def renderer_cache():
+    """``get(backend)``: one airlight.Renderer per backend for the whole session."""
+    cache: dict[str, airlight.Renderer] = {}
+
+    def get(name: str) -> airlight.Renderer:
+        skip_unless_backend_available(name)
+        if name not in cache:
+            cache[name] = airlight.Renderer(name)
+        return cache[name]
+
+    yield get
+    for r in cache.values():
+        r.close()
+
+
+@pytest.fixture
+def renderer(backend: str, renderer_cache) -> airlight.Renderer:
+    """A (shared) Renderer for the parametrised backend."""
+    return renderer_cache(backend)
+
+
+BASE_SCENE: dict[str, Any] = {
+    "film": {"width": 160, "height": 120},
+    "camera": {"position": [0.0, 1.7, 0.0], "look_at": [0.0, 1.0, -10.0], "up": [0.0, 1.0, 0.0],
+               "fov_y": 60.0},
+    "medium": {"sigma_t": 0.05, "albedo": 1.0, "phase": {"type": "isotropic"}},
+    "lights": [
+        {"type": "point", "position": [3.0, 5.0, -8.0], "intensity": [100.0, 90.0, 70.0], "radius": 0.1},
+    ],
+    "surfaces": [
+        {"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0], "albedo": [0.3, 0.3, 0.3]},
+        {"type": "box", "min": [-3.0, 0.0, -12.0], "max": [-1.0, 2.0, -9.0], "albedo": 0.5},
+        {"type": "sphere", "center": [1.5, 1.0, -10.0], "radius": 1.0, "albedo": [0.7, 0.2, 0.2]},
+    ],
+    "background": [0.0, 0.0, 0.0],
+}
+
+
+def make_scene(**overrides: Any) -> dict[str, Any]:
+    """A deep copy of BASE_SCENE with top-level keys replaced (a value of None for
+    "medium" keeps the key as null; use ``drop=[...]`` to remove keys)."""
+    drop = overrides.pop("drop", ())
+    scene = copy.deepcopy(BASE_SCENE)
+    for key, value in overrides.items():
+        scene[key] = copy.deepcopy(value)
+    for key in drop:
+        scene.pop(key, None)
+    return scene
+
+
+@pytest.fixture
+def scene_factory() -> Callable[..., dict[str, Any]]:
+    """``scene_factory(**overrides)``: a fresh copy of the small base scene."""
+    return make_scene

@@ -1,0 +1,39 @@
+// The daytime part of the frame (effects/daytime/physics.md): sky, sun, the
+// atmosphere's species and altitude levels, the switches and the sky-phase
+// table where the scene needs it.
+#include <algorithm>
+#include <vector>
+
+#include "frame_data.hpp"
+#include "sky.hpp"
+
+namespace airlight {
+
+void pack_daytime_frame(const Scene& scene, FrameData& data) {
+    shader::FrameUniforms& f = data.frame;
+    f.sky = make_sky_gpu(scene.sky, scene.sun);
+    make_species_gpu(scene.atmosphere, f.species);
+    data.features.sky =
+        scene.sky.model != SkyModel::none && glm::any(glm::greaterThan(scene.sky.zenith_radiance, glm::vec3(0.0f)));
+    data.features.sun = f.sky.sun_direction.w != 0.0f;
+    data.features.atmosphere = false;
+    for (const shader::SpeciesGpu& species : f.species) data.features.atmosphere |= species.phase.z != 0.0f;
+    data.features.sky_march = data.features.atmosphere && scene.quality.airlight == AirlightMethod::march;
+    float top = 0.0f;
+    std::vector<float> levels;
+    if (data.features.atmosphere) levels = make_altitude_levels(f.species, scene.quality.sky_segments, top);
+    for (size_t k = 0; k < levels.size() && k < size_t(shader::ATMOSPHERE_MAX_LEVELS); ++k)
+        f.altitude_levels[k / 4][int(k % 4)] = levels[k];
+    // The table: with its columns for a sky that lights an atmosphere, C = 0
+    // only for one that lights surfaces through clear air.
+    const bool columns = data.features.sky && data.features.atmosphere;
+    const Table2D* sky_table = nullptr;
+    if (columns || (data.features.sky && data.features.surfaces))
+        sky_table = data.tables[shader::TABLE_SKY_PHASE] = &sky_phase_table(f.sky, f.species, columns);
+    f.atmosphere_top = top;
+    f.altitude_level_count = float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS)));
+    f.sky_table_columns = sky_table ? float(sky_table->width) : 1.0f;
+    f.sky_table_azimuth_blocks = sky_table ? float(sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f;
+}
+
+}  // namespace airlight

@@ -1,0 +1,14 @@
+# Daytime: CIE skies, the sun and a height-varying atmosphere of molecules,
+# aerosol and rain (physics.md; effects/daytime/docs/daytime.md).
+set(EFFECT_SOURCES sky.cpp daytime_keys.cpp daytime_frame.cpp)
+set(EFFECT_SCENE_KEYS sky sun atmosphere)
+set(EFFECT_GLSL_MATH sky_math.glsl)
+set(EFFECT_GLSL_PIXEL sky.glsl)
+set(EFFECT_FEATURES
+    sky=HAS_SKY                # a sky dome: seen by escaping rays, lights surfaces
+    sun=HAS_SUN                # a sun above the horizon with some irradiance
+    atmosphere=HAS_ATMOSPHERE  # a height-varying atmosphere: scattering volumes along view rays
+    sky_march=SKY_MARCH)       # brute-force marching of the atmosphere instead (benchmarks)
+set(EFFECT_TABLES
+    sky_phase)  # F_k(C, d): the sky dome through each species' phase function
+set(EFFECT_FRAME 1)

@@ -1,0 +1,110 @@
+"""Rendering: backend discovery and selection (``"gl"``, ``"cpu"``, ``"auto"``),
+the :class:`Renderer` that keeps its backend's state across frames, one-frame
+:func:`render`, and :func:`table_stats` on the scattering tables built."""
+
+from __future__ import annotations
+
+import warnings
+from typing import Any
+
+import numpy as np
+
+from . import _core
+from ._core import BackendUnavailableError
+from ._scenes import SceneLike, _with_film_size
+
+# The class is registered by the native module, which gives it no docstring.
+BackendUnavailableError.__doc__ = (
+    "Raised (a ``RuntimeError``) when the GL backend is asked for where it cannot run:\n"
+    "``Renderer(\"gl\")`` with no working EGL device, GL disabled by ``AIRLIGHT_DISABLE_GL``\n"
+    "or a build without EGL/OpenGL. The message gives the reason; ``backend=\"auto\"``\n"
+    "falls back to the CPU instead (see :func:`gl_unavailable_reason`)."
+)
+
+_BACKENDS = ("auto", "gl", "cpu")
+_warned_fallback = False
+
+
+def gl_unavailable_reason() -> str | None:
+    """None when the GL backend can run here, else the reason it cannot."""
+    ok, reason = _core.gl_backend_available()
+    return None if ok else reason
+
+
+def available_backends() -> list[str]:
+    """The backends that can run on this machine: ``["gl", "cpu"]`` or ``["cpu"]``."""
+    return ["gl", "cpu"] if gl_unavailable_reason() is None else ["cpu"]
+
+
+class Renderer:
+    """Renders scenes, keeping the GL context, compiled shader variants and
+    tables across frames so that animations pay the set-up once.
+
+    ``backend`` is ``"gl"``, ``"cpu"`` or ``"auto"`` (GL when an EGL device
+    works, otherwise CPU with one warning). Asking for ``"gl"`` where it cannot
+    run raises :class:`BackendUnavailableError`.
+    """
+
+    def __init__(self, backend: str = "auto", *, cpu_threads: int = 0) -> None:
+        global _warned_fallback
+        if not isinstance(backend, str):
+            raise TypeError(f"backend: expected a string, got {type(backend).__name__}")
+        if backend not in _BACKENDS:
+            raise ValueError(f"backend: must be one of {', '.join(_BACKENDS)}, got {backend!r}")
+        if backend == "auto":
+            reason = gl_unavailable_reason()
+            if reason is None:
+                backend = "gl"
+            else:
+                backend = "cpu"
+                if not _warned_fallback:
+                    warnings.warn(f"airlight: GL backend unavailable ({reason}); using the CPU backend",
+                                  RuntimeWarning, stacklevel=2)
+                    _warned_fallback = True
+        if not isinstance(cpu_threads, int) or cpu_threads < 0:
+            raise ValueError(f"cpu_threads: must be an integer >= 0, got {cpu_threads!r}")
+        self._native: _core.Renderer | None = _core.Renderer(backend)
+        self._native.set_cpu_threads(cpu_threads)
+
+    @property
+    def backend(self) -> str:
+        """The backend in use: ``"gl"`` or ``"cpu"``."""
+        return self._active().backend
+
+    def _active(self) -> _core.Renderer:
+        if self._native is None:
+            raise RuntimeError("Renderer is closed")
+        return self._native
+
+    def render(self, scene: SceneLike, *, width: int | None = None,
+               height: int | None = None) -> np.ndarray:
+        """Linear radiance of ``scene``: float32 array (height, width, 3), row 0
+        on top. ``width``/``height`` override the scene's film size."""
+        return self._active().render(_with_film_size(scene, width, height))
+
+    def close(self) -> None:
+        """Releases the GL context and everything cached (idempotent)."""
+        self._native = None
+
+    def __enter__(self) -> Renderer:
+        return self
+
+    def __exit__(self, *exc: object) -> None:
+        self.close()
+
+
+def render(scene: SceneLike, backend: str = "auto", *, width: int | None = None,
+           height: int | None = None) -> np.ndarray:
+    """Renders one frame; see :class:`Renderer` (which is faster for many frames)."""
+    with Renderer(backend) as renderer:
+        return renderer.render(scene, width=width, height=height)
+
+
+def table_stats() -> dict[str, dict[str, Any]]:
+    """The scattering tables built so far in this process (each is built once, on
+    first need): name -> width, height, bytes, build_seconds, builds. Empty until a
+    scene with lamps in a scattering medium or a sky over an atmosphere or surfaces is
+    rendered. The sky table ("sky_phase", effects/daytime/docs/daytime.md) is rebuilt when the sky or
+    the species' phase functions change: ``builds`` counts its builds, the other
+    fields describe the last one."""
+    return dict(_core.tables_built())

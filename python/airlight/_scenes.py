@@ -1,0 +1,74 @@
+"""Scenes: the ``SceneLike`` inputs, validation and normalisation
+(:func:`load_scene`), and the presets shipped in the package's ``scenes/``
+directory (:func:`preset`, :func:`preset_names`)."""
+
+from __future__ import annotations
+
+import copy
+import json
+import os
+from collections.abc import Mapping
+from pathlib import Path
+from typing import Any, Union
+
+from . import _core
+
+SceneLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
+"""A scene dict, a path to a JSON scene file, or JSON text."""
+
+_SCENES_DIR = Path(__file__).resolve().parent / "scenes"
+
+
+def _scene_source(scene: SceneLike) -> Any:
+    """What the native validator takes: a dict, or JSON text read from a file."""
+    if isinstance(scene, Mapping):
+        return scene
+    if isinstance(scene, (str, os.PathLike)):
+        text = os.fspath(scene)
+        if isinstance(scene, str) and text.lstrip().startswith("{"):
+            return text
+        try:
+            return Path(text).read_text(encoding="utf-8")
+        except OSError as exc:
+            raise ValueError(f"path: cannot read scene file {text!r}: {exc.strerror}") from None
+        except (ValueError, UnicodeError) as exc:  # embedded NUL, undecodable bytes
+            raise ValueError(f"path: cannot read scene file {text!r}: {exc}") from None
+    raise TypeError(f"scene: expected a dict, a path or JSON text, got {type(scene).__name__}")
+
+
+def load_scene(scene: SceneLike) -> dict[str, Any]:
+    """Validates a scene and returns it normalised: every default filled in and
+    every RGB value expanded to a list of three floats.
+
+    Raises ``TypeError``/``ValueError`` naming the offending field.
+    """
+    return json.loads(_core.validate_scene(_scene_source(scene)))
+
+
+def _with_film_size(scene: SceneLike, width: int | None, height: int | None) -> Any:
+    """The scene source of ``scene`` with its film size overridden where given."""
+    source = _scene_source(scene)
+    if width is None and height is None:
+        return source
+    data = json.loads(source) if isinstance(source, str) else copy.deepcopy(dict(source))
+    film = data.get("film")
+    film = dict(film) if isinstance(film, Mapping) else {}
+    if width is not None:
+        film["width"] = width
+    if height is not None:
+        film["height"] = height
+    data["film"] = film
+    return data
+
+
+def preset_names() -> list[str]:
+    """Names of the scenes shipped with airlight (``preset(name)`` loads one)."""
+    return sorted(p.stem for p in _SCENES_DIR.glob("*.json"))
+
+
+def preset(name: str) -> dict[str, Any]:
+    """A shipped scene as a dict (edit it freely before rendering)."""
+    path = _SCENES_DIR / f"{name}.json"
+    if not path.is_file():
+        raise ValueError(f"preset: unknown preset {name!r}; available: {', '.join(preset_names())}")
+    return json.loads(path.read_text(encoding="utf-8"))
