@@ -13,8 +13,15 @@ namespace shader {
 struct CpuShader {
     const FrameData& data;
     const FrameUniforms& frame;
-    // The tables the code reads: the frame's, and the outputs of its grid passes.
-    std::array<const Table2D*, TABLE_COUNT> tables;
+    // The tables the code reads (the frame's, and the outputs of its grid
+    // passes): texels and row length per slot, read directly in the hot loops.
+    std::array<const float*, TABLE_COUNT> table_texels{};
+    std::array<size_t, TABLE_COUNT> table_widths{};
+
+    void set_table(int slot, const Table2D* t) {
+        table_texels[size_t(slot)] = t ? t->texels.data() : nullptr;
+        table_widths[size_t(slot)] = t ? size_t(t->width) : 0;
+    }
 
 #define AIRLIGHT_X(name, macro) bool macro;
     AIRLIGHT_FEATURES(AIRLIGHT_X)
@@ -22,27 +29,35 @@ struct CpuShader {
 
     explicit CpuShader(const FrameData& d)
         : data(d),
-          frame(d.frame),
-          tables(d.tables)
+          frame(d.frame)
 #define AIRLIGHT_X(name, macro) , macro(d.features.name)
               AIRLIGHT_FEATURES(AIRLIGHT_X)
 #undef AIRLIGHT_X
     {
+        for (int slot = 0; slot < TABLE_COUNT; ++slot) set_table(slot, d.tables[size_t(slot)]);
     }
 
-    // Texel (x, y) of table slot `table` (a single-channel texel as (r, 0, 0, 1), as GL's texelFetch).
-    vec4 table_texel4(int table, int x, int y) const {
-        const Table2D& t = *tables[size_t(table)];
-        const float* p = t.texels.data() + (size_t(y) * size_t(t.width) + size_t(x)) * size_t(t.channels);
-        return t.channels == 4 ? vec4(p[0], p[1], p[2], p[3]) : vec4(p[0], 0.0f, 0.0f, 1.0f);
+    // Texel (x, y) of table slot `table`: a single-channel table's (table_texel)
+    // or an RGBA one's (table_texel4), as GL's texelFetch reads them.
+    float table_texel(int table, int x, int y) const {
+        return table_texels[size_t(table)][size_t(y) * table_widths[size_t(table)] + size_t(x)];
     }
+    vec4 table_texel4(int table, int x, int y) const {
+        const float* t = table_texels[size_t(table)] + (size_t(y) * table_widths[size_t(table)] + size_t(x)) * 4;
+        return vec4(t[0], t[1], t[2], t[3]);
+    }
+    // The storage buffers' arrays (pointers kept: the accessors sit in the innermost loops).
+    const PointLightGpu* point_lights = data.point_lights.data();
+    const SurfaceGpu* surfaces = data.surfaces.data();
+    const BvhNodeGpu* bvh_nodes = data.bvh_nodes.data();
+    const SpotLightGpu* spot_lights = data.spot_lights.data();
     int spot_light_count() const { return frame.spot_light_count; }
-    SpotLightGpu spot_light(int i) const { return data.spot_lights[size_t(i)]; }
+    SpotLightGpu spot_light(int i) const { return spot_lights[i]; }
     int point_light_count() const { return frame.point_light_count; }
-    PointLightGpu point_light(int i) const { return data.point_lights[size_t(i)]; }
+    PointLightGpu point_light(int i) const { return point_lights[i]; }
     int surface_count() const { return frame.surface_count; }
-    SurfaceGpu surface(int i) const { return data.surfaces[size_t(i)]; }
-    BvhNodeGpu bvh_node(int i) const { return data.bvh_nodes[size_t(i)]; }
+    SurfaceGpu surface(int i) const { return surfaces[i]; }
+    BvhNodeGpu bvh_node(int i) const { return bvh_nodes[i]; }
 
 // The shading pass's functions: the core's and every effect's, in registry order.
 #include "airlight_glsl_pixel.inc"
@@ -85,7 +100,7 @@ void run_grid_passes(const FrameData& data, shader::CpuShader& program, std::vec
                 }
             },
             threads);
-        program.tables[size_t(job.slot)] = &t;
+        program.set_table(job.slot, &t);
     }
 }
 

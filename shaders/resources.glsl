@@ -20,6 +20,10 @@ BvhNodeGpu bvh_node(int i) { return bvh_nodes[i]; }
 // results agree exactly. Binding i holds slot i (gl_backend.cpp).
 layout(binding = 0) uniform sampler2D table_samplers[TABLE_COUNT];
 
+float table_texel(int table, int x, int y) {
+    return texelFetch(table_samplers[table], ivec2(x, y), 0).x;
+}
+
 vec4 table_texel4(int table, int x, int y) {
     return texelFetch(table_samplers[table], ivec2(x, y), 0);
 }

@@ -1,13 +1,9 @@
 // Table lookups shared by every effect (both backends): the texels come from
-// table_texel4(TABLE_*, x, y) (a sampler per slot on GL, resources.glsl; the
-// arrays of FrameData::tables on the CPU, cpu_backend.cpp), the interpolation
+// table_texel(TABLE_*, x, y) for a single-channel table and table_texel4 for
+// an RGBA one (a sampler per slot on GL, resources.glsl; the texel arrays of
+// FrameData::tables on the CPU, cpu_backend.cpp), the interpolation
 // is done here in float32 so that GPU and CPU agree exactly; and the
 // culling test and quadrature rules the effects' per-pixel code shares.
-
-// A texel of a single-channel table.
-float table_texel(int table, int x, int y) {
-    return table_texel4(table, x, y).x;
-}
 
 // Manual bilinear interpolation on a node-aligned grid (texel i at
 // X = i / (n - 1)): exact float32 arithmetic, identical on GPU and CPU (GL's

@@ -25,6 +25,7 @@ struct TableSampler {
         return vec4(t.texels[size_t(y) * t.width + x], 0.0f, 0.0f, 1.0f);
     }
 #include "airlight.glsl"
+    float table_texel(int table, int x, int y) const { return table_texel4(table, x, y).x; }
 #include "tables.glsl"
 };
 }  // namespace airlight::shader

@@ -38,6 +38,7 @@ struct PhaseSampler {
 #define HAS_PHASE true
 #include "airlight.glsl"
 #include "phase.glsl"
+    float table_texel(int table, int x, int y) const { return table_texel4(table, x, y).x; }
 #include "tables.glsl"
 #undef HAS_PHASE
 };
