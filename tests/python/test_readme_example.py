@@ -17,3 +17,14 @@ def test_readme_python_example_runs(tmp_path, monkeypatch):
     exec(compile(code, str(README), "exec"), {})
     assert (tmp_path / "fog.png").stat().st_size > 0
     assert (tmp_path / "fog.pfm").stat().st_size > 0
+
+
+def test_readme_lists_exactly_the_shipped_presets():
+    """The presets the README's API section names are the scenes shipped (no name that does not
+    exist, none left out)."""
+    import airlight
+
+    text = README.read_text(encoding="utf-8")
+    section = text[text.index("- `preset_names()`"):text.index("- `rainbow_phase(")]
+    named = set(re.findall(r"`([a-z_0-9]+)`", section)) - {"preset_names", "preset", "scenes"}
+    assert named == set(airlight.preset_names())
