@@ -50,10 +50,10 @@ Table2D timed_build(const char* name, Build build) {
 // timed, registered and kept for the process.
 template <class Build>
 const Table2D& table_built_once(const char* name, Build build) {
-    static const Table2D& table = [&]() -> const Table2D& {
-        static const Table2D built = timed_build(name, build);
-        register_table(built);
-        return built;
+    static const Table2D table = [&] {
+        Table2D t = timed_build(name, build);
+        register_table(t);
+        return t;
     }();
     return table;
 }
