@@ -41,6 +41,9 @@ struct GlDisplayOutput {
 class CpuBackend {
 public:
     void render(const FrameData& data, Image& out);
+    // Recomputes the listed pixels (indices row * width + x) of `out`, a
+    // frame of data's film size (the GL backend's cut pixels).
+    void render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out);
     // The outputs of data.grid_passes alone, in order (tests).
     std::vector<Table2D> grid_passes(const FrameData& data);
     int threads = 0;  // 0: std::thread::hardware_concurrency()
@@ -52,7 +55,11 @@ public:
     ~GlBackend();
     GlBackend(const GlBackend&) = delete;
     GlBackend& operator=(const GlBackend&) = delete;
-    void render(const FrameData& data, Image& out);
+    // Renders the frame; `cut_pixels` (if given) receives the pixels whose
+    // shader loops the driver cut short (Mesa llvmpipe's loop limiter: see
+    // render.frag), which are wrong and must be recomputed (Renderer::render
+    // does it on the CPU).
+    void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr);
     // The display stage on the GPU (see GlDisplayJob).
     void display(const GlDisplayJob& job, GlDisplayOutput& out);
     // The glare convolution of the display pass alone (fp32 FFT on the GPU),

@@ -1,5 +1,8 @@
 // CPU backend: the shared GLSL per-pixel code compiled as C++ (shader_cpp.hpp),
 // run over the image rows by a pool of threads.
+#include <algorithm>
+#include <stdexcept>
+
 #include "backends.hpp"
 #include "numerics.hpp"
 
@@ -111,6 +114,31 @@ std::vector<Table2D> CpuBackend::grid_passes(const FrameData& data) {
     std::vector<Table2D> tables;
     run_grid_passes(data, program, tables, threads);
     return tables;
+}
+
+void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out) {
+    const size_t width = size_t(data.frame.film_width);
+    if (out.width != data.frame.film_width || out.height != data.frame.film_height)
+        throw std::logic_error("airlight: render_pixels needs a frame of the film's size");
+    shader::CpuShader program(data);
+    std::vector<Table2D> pass_tables;
+    run_grid_passes(data, program, pass_tables, threads);
+    constexpr int kBatch = 256;  // pixels per task
+    const int batches = int((pixels.size() + kBatch - 1) / kBatch);
+    numerics::parallel_for(
+        batches,
+        [&](int b) {
+            shader::CpuShader local = program;
+            const size_t end = std::min(pixels.size(), size_t(b + 1) * kBatch);
+            for (size_t k = size_t(b) * kBatch; k < end; ++k) {
+                const size_t pixel = pixels[k];
+                const glm::vec3 radiance = local.render_pixel(int(pixel % width), int(pixel / width));
+                out.rgb[3 * pixel + 0] = radiance.r;
+                out.rgb[3 * pixel + 1] = radiance.g;
+                out.rgb[3 * pixel + 2] = radiance.b;
+            }
+        },
+        threads);
 }
 
 void CpuBackend::render(const FrameData& data, Image& out) {

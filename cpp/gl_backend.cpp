@@ -3,13 +3,16 @@
 // read back with glReadPixels. See shared HEADLESS-GL notes in docs/.
 #include <EGL/egl.h>
 #include <EGL/eglext.h>
+#include <pthread.h>
 
 #include <algorithm>
 #include <array>
+#include <atomic>
 #include <cstdlib>
 #include <cstring>
 #include <map>
 #include <memory>
+#include <mutex>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -67,6 +70,24 @@ struct EglContext {
     EGLContext context = EGL_NO_CONTEXT;
 };
 
+// ---- Fork safety. EGL and the GL driver keep per-process state (Mesa's
+// llvmpipe: a pool of rasteriser threads) that a forked child inherits
+// without the threads: any GL call there waits forever. So once this process
+// has initialised EGL, a child forked from it refuses GL with this message
+// (gl_backend_available is false there, Renderer("gl") and the parent's GL
+// renderers throw) instead of hanging.
+std::atomic<bool> forked_after_egl{false};
+
+constexpr const char* kForkedReason =
+    "this process was forked after its parent had initialised GL, whose driver state does not survive "
+    "a fork; start worker processes with the 'spawn' or 'forkserver' method (multiprocessing), or "
+    "use the GL backend only in the children";
+
+void note_egl_initialised() {
+    static std::once_flag once;
+    std::call_once(once, [] { pthread_atfork(nullptr, nullptr, [] { forked_after_egl = true; }); });
+}
+
 // Tries each display until one gives a 4.5 core context; returns false with
 // the reason otherwise.
 bool create_context(EglContext& out, std::string& reason) {
@@ -75,6 +96,11 @@ bool create_context(EglContext& out, std::string& reason) {
         reason = "disabled by AIRLIGHT_DISABLE_GL";
         return false;
     }
+    if (forked_after_egl) {
+        reason = kForkedReason;
+        return false;
+    }
+    note_egl_initialised();
     std::vector<EGLDisplay> displays = candidate_displays();
     if (displays.empty()) {
         reason = "no EGL display (no device or surfaceless platform)";
@@ -124,6 +150,10 @@ void destroy_context(EglContext& c) {
 }
 
 constexpr int kTile = 2048;  // largest tile drawn at once (GlBackend::render)
+
+// Iterations of render.frag's last loop, which finishes only where the
+// driver's loop limiter has not cut the pixel's loops.
+constexpr int kLoopGuardIterations = 2;
 
 }  // namespace
 
@@ -187,11 +217,28 @@ struct GlBackend::State {
     // ---- The display stage (effects/display/display_gl.cpp: GlBackend::display, glare_convolve).
     std::unique_ptr<GlDisplayPasses> display_passes;
 
-    void make_current() {
-        if (!eglMakeCurrent(egl.display, EGL_NO_SURFACE, EGL_NO_SURFACE, egl.context)) {
-            throw BackendUnavailable("airlight: eglMakeCurrent failed");
+    // One call at a time, from any thread: each call holds the lock and has
+    // the context current on its thread for its duration only (Current).
+    std::mutex mutex;
+
+    class Current {
+    public:
+        explicit Current(State& s) : lock_(s.mutex), display_(s.egl.display) {
+            if (forked_after_egl)
+                throw BackendUnavailable(std::string("airlight: this GL renderer cannot be used here: ") +
+                                         kForkedReason);
+            if (!eglMakeCurrent(s.egl.display, EGL_NO_SURFACE, EGL_NO_SURFACE, s.egl.context))
+                throw BackendUnavailable("airlight: eglMakeCurrent failed (EGL error " + std::to_string(eglGetError()) +
+                                         ")");
         }
-    }
+        ~Current() { eglMakeCurrent(display_, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT); }
+        Current(const Current&) = delete;
+        Current& operator=(const Current&) = delete;
+
+    private:
+        std::lock_guard<std::mutex> lock_;
+        EGLDisplay display_;
+    };
 
     // The shading pass's program for `features` (grid_pass_slot -1), or that of
     // the grid pass filling that table slot.
@@ -271,11 +318,15 @@ GlBackend::GlBackend() : state_(std::make_unique<State>()) {
     glCreateBuffers(1, &state_->bvh_ssbo);
     glCreateBuffers(1, &state_->spot_ssbo);
     state_->display_passes = std::make_unique<GlDisplayPasses>();
+    // Released: the next call makes it current on its own thread (State::Current).
+    eglMakeCurrent(state_->egl.display, EGL_NO_SURFACE, EGL_NO_SURFACE, EGL_NO_CONTEXT);
 }
 
 GlBackend::~GlBackend() {
-    if (state_->egl.context != EGL_NO_CONTEXT) {
-        state_->make_current();
+    // In a child forked after GL was initialised, the driver is unusable: its
+    // objects are left to the process's end.
+    if (state_->egl.context != EGL_NO_CONTEXT && !forked_after_egl) {
+        State::Current current(*state_);
         for (auto& entry : state_->programs) glDeleteProgram(entry.second);
         for (auto& entry : state_->table_textures) glDeleteTextures(1, &entry.second.second);
         glDeleteTextures(1, &state_->color);
@@ -288,13 +339,13 @@ GlBackend::~GlBackend() {
         GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo,
                             state_->spot_ssbo};
         glDeleteBuffers(5, buffers);
-        destroy_context(state_->egl);
     }
+    if (!forked_after_egl) destroy_context(state_->egl);
 }
 
-void GlBackend::render(const FrameData& data, Image& out) {
+void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels) {
     State& s = *state_;
-    s.make_current();
+    State::Current current(s);
     const int width = data.frame.film_width;
     const int height = data.frame.film_height;
     // The film is drawn in tiles (at most kTile x kTile pixels each): any film
@@ -308,6 +359,7 @@ void GlBackend::render(const FrameData& data, Image& out) {
     const GLuint program = s.program_for(data.features);
 
     shader::FrameUniforms frame = data.frame;
+    frame.loop_guard_iterations = kLoopGuardIterations;
     upload(s.frame_ubo, GL_UNIFORM_BUFFER, &frame, sizeof(frame), s.frame_capacity);
     upload(s.light_ssbo, GL_SHADER_STORAGE_BUFFER, data.point_lights.data(),
            data.point_lights.size() * sizeof(shader::PointLightGpu), s.light_capacity);
@@ -341,8 +393,10 @@ void GlBackend::render(const FrameData& data, Image& out) {
     out.width = width;
     out.height = height;
     out.rgb.resize(size_t(width) * size_t(height) * 3);
+    if (cut_pixels != nullptr) cut_pixels->clear();
+    // Each tile is read back as RGBA: alpha 0 marks a pixel whose loops the driver cut (render.frag).
+    std::vector<float> rgba(size_t(tile_w) * size_t(tile_h) * 4);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
-    glPixelStorei(GL_PACK_ROW_LENGTH, width);
     for (int y0 = 0; y0 < height; y0 += tile_h) {
         for (int x0 = 0; x0 < width; x0 += tile_w) {
             const int w = std::min(tile_w, width - x0), h = std::min(tile_h, height - y0);
@@ -353,10 +407,17 @@ void GlBackend::render(const FrameData& data, Image& out) {
             }
             glViewport(0, 0, w, h);
             glDrawArrays(GL_TRIANGLES, 0, 3);
-            glReadPixels(0, 0, w, h, GL_RGB, GL_FLOAT, out.rgb.data() + (size_t(y0) * width + x0) * 3);
+            glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba.data());
+            for (int y = 0; y < h; ++y) {
+                for (int x = 0; x < w; ++x) {
+                    const float* src = rgba.data() + (size_t(y) * size_t(w) + size_t(x)) * 4;
+                    const size_t pixel = size_t(y0 + y) * size_t(width) + size_t(x0 + x);
+                    std::copy(src, src + 3, out.rgb.data() + pixel * 3);
+                    if (src[3] < 0.5f && cut_pixels != nullptr) cut_pixels->push_back(pixel);
+                }
+            }
         }
     }
-    glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) throw std::runtime_error("airlight: GL error " + std::to_string(err) + " while rendering");
 }
@@ -364,13 +425,13 @@ void GlBackend::render(const FrameData& data, Image& out) {
 // The display stage: effects/display/display_gl.cpp (GlDisplayPasses), with the context current.
 void GlBackend::display(const GlDisplayJob& job, GlDisplayOutput& out) {
     check_display_image(job.linear);
-    state_->make_current();
+    State::Current current(*state_);
     state_->display_passes->display(job, out);
 }
 
 void GlBackend::glare_convolve(const Image& in, const GlareKernel& kernel, Image& out) {
     check_display_image(&in);
-    state_->make_current();
+    State::Current current(*state_);
     state_->display_passes->glare_convolve(in, kernel, out);
 }
 

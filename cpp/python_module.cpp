@@ -377,6 +377,7 @@ PYBIND11_MODULE(_core, m) {
         .def_property_readonly("backend",
                                [](const airlight::Renderer& r) { return airlight::backend_name(r.backend()); })
         .def("set_cpu_threads", &airlight::Renderer::set_cpu_threads)
+        .def_property_readonly("cpu_fallback_pixels", &airlight::Renderer::cpu_fallback_pixels)
         .def("render", [](airlight::Renderer& r, py::handle scene_obj) {
             const Scene scene = scene_from_python(scene_obj);
             airlight::Image image;

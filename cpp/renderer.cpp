@@ -1,5 +1,8 @@
 #include "airlight/renderer.hpp"
 
+#include <mutex>
+#include <vector>
+
 #include "backends.hpp"
 #include "display_stage.hpp"
 
@@ -11,6 +14,8 @@ struct Renderer::Impl {
     Backend backend;
     CpuBackend cpu;
     std::unique_ptr<GlBackend> gl;
+    size_t cpu_fallback_pixels = 0;  // of the last frame
+    std::mutex mutex;                // one call at a time, from any thread
 };
 
 Renderer::Renderer(Backend backend) : impl_(std::make_unique<Impl>()) {
@@ -22,17 +27,30 @@ Renderer::~Renderer() = default;
 
 Backend Renderer::backend() const { return impl_->backend; }
 
+size_t Renderer::cpu_fallback_pixels() const {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
+    return impl_->cpu_fallback_pixels;
+}
+
 void Renderer::set_cpu_threads(int threads) { impl_->cpu.threads = threads; }
 
 DisplayImage Renderer::display(const Image& linear, const DisplaySettings& settings, double fov_y_degrees) {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
     return run_display_stage(linear, settings, fov_y_degrees, impl_->cpu.threads, impl_->gl.get());
 }
 
 Image Renderer::render(const Scene& scene) {
+    std::lock_guard<std::mutex> lock(impl_->mutex);
     const FrameData data = make_frame_data(scene);
     Image image;
+    impl_->cpu_fallback_pixels = 0;
     if (impl_->gl) {
-        impl_->gl->render(data, image);
+        // Pixels the GL driver could not finish (its loop limit) are recomputed
+        // exactly on the CPU, so every scene is right on every backend.
+        std::vector<size_t> cut;
+        impl_->gl->render(data, image, &cut);
+        if (!cut.empty()) impl_->cpu.render_pixels(data, cut, image);
+        impl_->cpu_fallback_pixels = cut.size();
     } else {
         impl_->cpu.render(data, image);
     }

@@ -39,7 +39,9 @@ bool gl_backend_available(std::string* reason = nullptr);
 
 // Keeps what is expensive to set up (the GL context, compiled shader variants,
 // and later the scattering tables) across frames, so that animations pay the
-// set-up once. Not thread safe: use one Renderer per thread.
+// set-up once. Usable from any thread, one call at a time (concurrent calls
+// wait their turn); a GL renderer not in a child forked after GL was
+// initialised (it throws BackendUnavailable there).
 class Renderer {
 public:
     // Throws BackendUnavailable for Backend::gl when GL cannot run here.
@@ -56,6 +58,12 @@ public:
     // tone curve on the GPU. fov_y_degrees: the camera's vertical field of
     // view (the glare's angular scale). Include airlight/display.hpp to call.
     DisplayImage display(const Image& linear, const DisplaySettings& settings, double fov_y_degrees);
+
+    // Pixels of the last frame that the GL backend could not finish within
+    // its driver's loop limit (Mesa llvmpipe: 65535 loop iterations per
+    // invocation, e.g. thousands of lamps) and that were recomputed on the
+    // CPU; 0 on the CPU backend and for most scenes.
+    size_t cpu_fallback_pixels() const;
 
     // Number of CPU threads used by the CPU backend (default: all cores).
     void set_cpu_threads(int threads);

@@ -71,6 +71,14 @@ class Renderer:
         """The backend in use: ``"gl"`` or ``"cpu"``."""
         return self._active().backend
 
+    @property
+    def cpu_fallback_pixels(self) -> int:
+        """Pixels of the last frame that the GL backend could not finish and
+        recomputed on the CPU: Mesa's llvmpipe cuts a pixel's shader loops after
+        65535 iterations in all (thousands of lamps or spots over lit
+        surfaces). 0 on the CPU backend and for ordinary scenes."""
+        return self._active().cpu_fallback_pixels
+
     def _active(self) -> _core.Renderer:
         if self._native is None:
             raise RuntimeError("Renderer is closed")
