@@ -49,20 +49,40 @@ float intersect_surface(SurfaceGpu s, vec3 origin, vec3 dir, float t_min, OUT(ve
         else normal = vec3(0.0f, 0.0f, -sign(dir.z));
         return t;
     }
-    // Sphere: |origin + t dir - c|^2 = r^2 with |dir| = 1; the stable form
-    // of the roots avoids cancellation for distant spheres.
+    // Sphere: |origin + t dir - c|^2 = r^2 with |dir| = 1, roots -b -+ h with
+    // h^2 = r^2 - d^2 (d: the ray's distance from the centre), formed as
+    // (r - d)(r + d) and square-rooted factor by factor: no cancellation for
+    // distant spheres and no overflow of r^2 for huge ones.
     vec3 oc = origin - vec3(s.p0);
     float r = s.p1.x;
     float b = dot(oc, dir);
-    vec3 perp = oc - b * dir;  // component of oc across the ray
-    float disc = r * r - dot(perp, perp);
-    if (disc < 0.0f) return NO_HIT;
-    float h = sqrt(disc);
+    float d = length(oc - b * dir);  // component of oc across the ray
+    if (d > r) return NO_HIT;
+    float h = sqrt(r - d) * sqrt(r + d);
     float t = -b - h;
     if (t <= t_min) t = -b + h;
     if (t <= t_min) return NO_HIT;
     normal = (origin + t * dir - vec3(s.p0)) / r;
     return t;
+}
+
+// Distance along a ray from a point of surface s itself (a shadow ray) to
+// where it meets s again, or NO_HIT. Every surface is convex: a plane never
+// meets the ray again; a ray leaving a sphere neither, one entering it meets
+// it where it leaves, at the far root -2 b (exact for an origin on the
+// sphere). The general test would meet the sphere again at t ~ 0 wherever
+// float rounding, about 6e-8 (|c| + r), puts the origin inside: shadow acne
+// that no fixed offset beats on large spheres. Boxes keep the general test
+// (their faces are axis-aligned coordinates, which surface_offset covers).
+float intersect_own_surface(SurfaceGpu s, vec3 origin, vec3 dir, OUT(vec3) normal) {
+    int type = int(s.albedo_type.w + 0.5f);
+    normal = vec3(0.0f, 1.0f, 0.0f);
+    if (type == SURFACE_PLANE) return NO_HIT;
+    if (type == SURFACE_SPHERE) {
+        float b = dot(origin - vec3(s.p0), dir);
+        return b < 0.0f ? -2.0f * b : NO_HIT;
+    }
+    return intersect_surface(s, origin, dir, 0.0f, normal);
 }
 
 // True when the ray segment origin + t dir, t in [0, t_max), meets the box;
@@ -77,17 +97,25 @@ bool ray_meets_box(vec3 origin, vec3 inv_dir, vec3 lo, vec3 hi, float t_max) {
     return t_near <= t_far;
 }
 
+// The distance to surface i along the ray, from a point of surface self
+// (-1: from anywhere else).
+float intersect_surface_from(int i, int self, vec3 origin, vec3 dir, OUT(vec3) normal) {
+    if (i == self) return intersect_own_surface(surface(i), origin, dir, normal);
+    return intersect_surface(surface(i), origin, dir, 0.0f, normal);
+}
+
 // Nearest surface hit along the ray closer than t_max, or any hit when
 // `any_hit` (shadow rays): planes one by one, the bounded surfaces through the
-// BVH. Returns the distance (NO_HIT if none) with its surface index and
-// geometric normal.
-float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT(int) hit_index, OUT(vec3) hit_normal) {
+// BVH. `self`: the surface the ray starts on (-1: none). Returns the distance
+// (NO_HIT if none) with its surface index and geometric normal.
+float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, int self, OUT(int) hit_index,
+                           OUT(vec3) hit_normal) {
     float best = t_max;
     hit_index = -1;
     hit_normal = vec3(0.0f, 1.0f, 0.0f);
     for (int i = 0; i < frame.plane_count; ++i) {
         vec3 n;
-        float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
+        float t = intersect_surface_from(i, self, origin, dir, n);
         if (t < best) {
             best = t;
             hit_index = i;
@@ -112,7 +140,7 @@ float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT
         }
         for (int i = node.info.x; i < node.info.x + node.info.y; ++i) {
             vec3 n;
-            float t = intersect_surface(surface(i), origin, dir, 0.0f, n);
+            float t = intersect_surface_from(i, self, origin, dir, n);
             if (t < best) {
                 best = t;
                 hit_index = i;
@@ -127,16 +155,17 @@ float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, OUT
 // Closest surface along the ray: returns its distance (NO_HIT if none), its
 // index and its normal turned to face the ray origin.
 float trace_surfaces(vec3 origin, vec3 dir, OUT(int) hit_index, OUT(vec3) hit_normal) {
-    float best = trace_surfaces_below(origin, dir, NO_HIT, false, hit_index, hit_normal);
+    float best = trace_surfaces_below(origin, dir, NO_HIT, false, -1, hit_index, hit_normal);
     if (dot(hit_normal, dir) > 0.0f) hit_normal = -hit_normal;
     return best;
 }
 
-// True when any surface blocks the segment origin + t dir, 0 < t < max_t.
-bool segment_occluded(vec3 origin, vec3 dir, float max_t) {
+// True when any surface blocks the segment origin + t dir, 0 < t < max_t,
+// which starts on surface `self` (-1: on none).
+bool segment_occluded(vec3 origin, vec3 dir, float max_t, int self) {
     int index;
     vec3 n;
-    return trace_surfaces_below(origin, dir, max_t, true, index, n) < max_t;
+    return trace_surfaces_below(origin, dir, max_t, true, self, index, n) < max_t;
 }
 
 // Distance to the near side of lamp `i`'s sphere along the ray, or NO_HIT.

@@ -42,7 +42,8 @@ vec3 surface_glow_bound(vec3 intensity, vec3 attenuation, float dist, float radi
 // along the lamp-to-point path and hard shadows from every surface; plus, in
 // a scattering medium, the light scattered once on the way (not shadowed).
 // Inside a lamp's radius the falloff is held at its value on the lamp's sphere.
-vec3 point_light_irradiance(vec3 p, vec3 n) {
+// p lies on surface `self`.
+vec3 point_light_irradiance(vec3 p, vec3 n, int self) {
     vec3 irradiance = vec3(0.0f);
     vec3 shadow_origin = p + surface_offset(p) * n;
     for (int i = 0; i < point_light_count(); ++i) {
@@ -61,7 +62,7 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
         if (negligible(direct + glow_bound, irradiance)) continue;
         if (HAS_AIRLIGHT) irradiance += surface_glow_irradiance(intensity, dist, radius, cos_theta);
         if (cos_theta <= 0.0f) continue;
-        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
+        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius, self)) continue;
         irradiance += direct;
     }
     return irradiance;
@@ -72,7 +73,8 @@ vec3 point_light_irradiance(vec3 p, vec3 n) {
 // (effects/spotlights/physics.md); plus, in a scattering medium, the light each spot
 // scatters once on the way (spot_surface_glow, not shadowed), bounded for
 // culling by the glow of a point lamp of intensity I0 (the profile is <= 1).
-vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
+// p lies on surface `self`.
+vec3 spot_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     vec3 irradiance = vec3(0.0f);
     vec3 shadow_origin = p + surface_offset(p) * n;
     for (int i = 0; i < spot_light_count(); ++i) {
@@ -93,7 +95,7 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, vec3 so_far) {
         if (negligible(direct + glow_bound, irradiance + so_far)) continue;
         if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.spot_glow_samples));
         if (profile <= 0.0f) continue;
-        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius)) continue;
+        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius, self)) continue;
         irradiance += direct;
     }
     return irradiance;
@@ -289,11 +291,11 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
         vec3 irradiance = vec3(0.0f);
         // A black surface reflects nothing: skip its lighting (and shadow rays).
         bool black = albedo.x == 0.0f && albedo.y == 0.0f && albedo.z == 0.0f;
-        if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal);
-        if (HAS_SPOT_LIGHTS && !black) irradiance += spot_light_irradiance(p, normal, irradiance);
+        if (HAS_POINT_LIGHTS && !black) irradiance += point_light_irradiance(p, normal, hit_index);
+        if (HAS_SPOT_LIGHTS && !black) irradiance += spot_light_irradiance(p, normal, hit_index, irradiance);
         if (HAS_SKY && !black) irradiance += sky_irradiance(p, normal);
         if (HAS_SUN && !black && dot(normal, vec3(frame.sky.sun_direction)) > 0.0f) {
-            float visible = sun_visibility(p, normal);  // effects/sun_shadow_map
+            float visible = sun_visibility(p, normal, hit_index);  // effects/sun_shadow_map
             if (visible > 0.0f) irradiance += visible * sun_irradiance(p, normal);
         }
         radiance = albedo / PI * irradiance;

@@ -54,12 +54,12 @@ float sun_shadow_map_visibility(vec3 p, vec3 n) {
 }
 
 // The sun's visibility from surface point p (normal n, facing the sun): 1 lit,
-// 0 in shadow, between at the map's filtered shadow edges.
-float sun_visibility(vec3 p, vec3 n) {
+// 0 in shadow, between at the map's filtered shadow edges. p lies on surface `self`.
+float sun_visibility(vec3 p, vec3 n, int self) {
     if (!HAS_SURFACES) return 1.0f;
     if (HAS_SUN_SHADOW_MAP) {
         float v = sun_shadow_map_visibility(p, n);
         if (v >= 0.0f) return v;
     }
-    return segment_occluded(p + surface_offset(p) * n, vec3(frame.sky.sun_direction), NO_HIT) ? 0.0f : 1.0f;
+    return segment_occluded(p + surface_offset(p) * n, vec3(frame.sky.sun_direction), NO_HIT, self) ? 0.0f : 1.0f;
 }
