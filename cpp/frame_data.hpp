@@ -33,6 +33,14 @@ struct FrameData {
     // effects' EFFECT_TABLES); null where the scene does not need one: it is
     // then never built.
     std::array<const Table2D*, shader::TABLE_COUNT> tables{};
+    // The tables of `tables` that a TableCache holds, kept alive for the frame
+    // (the cache may evict them meanwhile); use_table sets both.
+    std::vector<std::shared_ptr<const Table2D>> table_owners;
+    // Puts a cached table in slot `slot` (shader::TABLE_*) for this frame.
+    void use_table(int slot, std::shared_ptr<const Table2D> table) {
+        tables[size_t(slot)] = table.get();
+        table_owners.push_back(std::move(table));
+    }
     // Grid passes to run first, in order (a pass may read the tables of those before it).
     std::vector<GridPassJob> grid_passes;
 };

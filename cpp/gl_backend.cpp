@@ -214,6 +214,22 @@ struct GlBackend::State {
         return tex;
     }
 
+    // Deletes the textures of tables this frame does not use once more than
+    // kMaxTableTextures are kept: a TableCache's evicted tables (an animated
+    // phase g, a moving sun) would otherwise keep theirs for the renderer's life.
+    static constexpr size_t kMaxTableTextures = 32;
+    void prune_table_textures(const FrameData& data) {
+        if (table_textures.size() <= kMaxTableTextures) return;
+        for (auto it = table_textures.begin(); it != table_textures.end();) {
+            if (std::find(data.tables.begin(), data.tables.end(), it->first) == data.tables.end()) {
+                glDeleteTextures(1, &it->second.second);
+                it = table_textures.erase(it);
+            } else {
+                ++it;
+            }
+        }
+    }
+
     // ---- The display stage (effects/display/display_gl.cpp: GlBackend::display, glare_convolve).
     std::unique_ptr<GlDisplayPasses> display_passes;
 
@@ -379,6 +395,7 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
         const Table2D* table = data.tables[size_t(slot)];
         if (table != nullptr) glBindTextureUnit(GLuint(slot), s.texture_for(*table));
     }
+    s.prune_table_textures(data);
     glDisable(GL_DEPTH_TEST);
     glDisable(GL_BLEND);
     // The grid passes, in order, each into its slot (read by the passes after it and the shading pass).

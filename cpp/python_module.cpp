@@ -259,6 +259,9 @@ PYBIND11_MODULE(_core, m) {
             d["height"] = info.height;
             d["bytes"] = info.bytes;
             d["build_seconds"] = info.build_seconds;
+            // Tables of this name in memory now (a TableCache evicts the least recently used).
+            const int resident = out.contains(info.name) ? out[info.name.c_str()]["resident"].cast<int>() : 0;
+            d["resident"] = resident + (info.resident ? 1 : 0);
             out[info.name.c_str()] = d;
         }
         return out;

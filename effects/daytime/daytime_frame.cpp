@@ -28,8 +28,10 @@ void pack_daytime_frame(const Scene& scene, FrameData& data) {
     // only for one that lights surfaces through clear air.
     const bool columns = data.features.sky && data.features.atmosphere;
     const Table2D* sky_table = nullptr;
-    if (columns || (data.features.sky && data.features.surfaces))
-        sky_table = data.tables[shader::TABLE_SKY_PHASE] = &sky_phase_table(f.sky, f.species, columns);
+    if (columns || (data.features.sky && data.features.surfaces)) {
+        data.use_table(shader::TABLE_SKY_PHASE, sky_phase_table(f.sky, f.species, columns));
+        sky_table = data.tables[shader::TABLE_SKY_PHASE];
+    }
     f.atmosphere_top = top;
     f.altitude_level_count = float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS)));
     f.sky_table_columns = sky_table ? float(sky_table->width) : 1.0f;

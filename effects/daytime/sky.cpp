@@ -3,8 +3,6 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <list>
-#include <mutex>
 #include <string>
 
 #include "numerics.hpp"
@@ -311,11 +309,6 @@ void ring_sums(const shader::SpeciesGpu species[shader::SPECIES_COUNT], const Ru
     }
 }
 
-struct CachedTable {
-    std::string key;
-    Table2D table;
-};
-
 std::string table_key(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
                       bool columns) {
     std::string key = std::to_string(int(sky.zenith_radiance.w)) + "|" + std::to_string(columns);
@@ -353,19 +346,17 @@ double sky_kernel_integral(const shader::SkyGpu& sky, const shader::SpeciesGpu s
     return total;
 }
 
-const Table2D& sky_phase_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
-                               bool columns) {
-    static std::mutex mutex;
-    static std::list<CachedTable> cache;  // most recent first; addresses stay valid while cached
-    static long serial = 0;
-    const std::string key = table_key(sky, species, columns);
-    std::lock_guard<std::mutex> lock(mutex);
-    for (auto it = cache.begin(); it != cache.end(); ++it) {
-        if (it->key == key) {
-            cache.splice(cache.begin(), cache, it);
-            return cache.front().table;
-        }
-    }
+static Table2D build_sky_phase_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                     bool columns);
+
+std::shared_ptr<const Table2D> sky_phase_table(const shader::SkyGpu& sky,
+                                               const shader::SpeciesGpu species[shader::SPECIES_COUNT], bool columns) {
+    static TableCache<std::string> cache(8);  // the last 8 skies
+    return cache.get(table_key(sky, species, columns), [&] { return build_sky_phase_table(sky, species, columns); });
+}
+
+static Table2D build_sky_phase_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                     bool columns) {
     const auto start = std::chrono::steady_clock::now();
     const bool azimuth = sky_has_azimuth(sky);
     const int nc = columns ? shader::SKY_TABLE_NC : 1;
@@ -414,11 +405,7 @@ const Table2D& sky_phase_table(const shader::SkyGpu& sky, const shader::SpeciesG
     const auto build = [&](int row, int worker) { build_row(row, sums[size_t(worker)]); };
     numerics::parallel_for_worker(rows, build, int(workers));
     t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
-    t.serial = ++serial;
-    register_table(t);
-    cache.push_front({key, std::move(t)});
-    if (cache.size() > 8) cache.pop_back();
-    return cache.front().table;
+    return t;
 }
 
 }  // namespace airlight

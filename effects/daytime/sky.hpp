@@ -4,6 +4,7 @@
 // scattering volumes, and the sky-phase table.
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "airlight/scene.hpp"
@@ -54,9 +55,10 @@ bool sky_has_azimuth(const shader::SkyGpu& sky);
 // The sky-phase table F_k(C, d) (constants.glsl) for this sky and these
 // species' phase functions: RGBA, SKY_TABLE_NC (or 1 when `columns` is false:
 // C = 0 only) texels wide, SKY_TABLE_N_ELEVATION x (SKY_TABLE_N_AZIMUTH or 1)
-// rows. Built on first use and kept in a small cache (thread safe).
-const Table2D& sky_phase_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
-                               bool columns);
+// rows. Built on first use and cached for the last 8 skies (thread safe;
+// TableCache).
+std::shared_ptr<const Table2D> sky_phase_table(const shader::SkyGpu& sky,
+                                               const shader::SpeciesGpu species[shader::SPECIES_COUNT], bool columns);
 
 // The exact kernel integral by the same hemisphere rule (tests, analysis):
 // F_k(C, d) for kernel k (0..2 species phase, 3 clamped cosine).

@@ -74,8 +74,8 @@ void pick_phase_tables(const Scene& scene, FrameData& data) {
     for (size_t i = 0; i < lobes.size(); ++i) {
         const auto& [lobe, weight] = lobes[i];
         airlight_bound += weight * phase_airlight_bound(lobe);
-        if (moments) data.tables[size_t(shader::TABLE_PHASE_MOMENTS_0) + i] = &phase_moment_table(lobe);
-        if (glow) data.tables[size_t(shader::TABLE_PHASE_GLOW_0) + i] = &phase_glow_table(lobe);
+        if (moments) data.use_table(shader::TABLE_PHASE_MOMENTS_0 + int(i), phase_moment_table(lobe));
+        if (glow) data.use_table(shader::TABLE_PHASE_GLOW_0 + int(i), phase_glow_table(lobe));
         // The glow culling bound (a spot's glow is at most a lamp's): the
         // slice's maximum of G (for g < 0 above the isotropic 8.08: 63 at
         // g = -0.9); without a slice (spots only) G <= 2 pi^2 int_0^{pi/2} P dt,

@@ -3,10 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
-#include <deque>
-#include <map>
 #include <memory>
-#include <mutex>
 #include <string>
 #include <vector>
 
@@ -110,19 +107,13 @@ std::string lobe_name(const char* what, const PhaseLobe& lobe) {
     return std::string(what) + g;
 }
 
-// Per-lobe tables, kept for the process (their addresses key the GL textures).
-struct LobeTables {
-    std::unique_ptr<Table2D> moments;
-    std::unique_ptr<Table2D> glow;
-};
-std::mutex lobe_mutex;
-std::map<std::pair<bool, float>, LobeTables>& lobe_tables() {
-    static std::map<std::pair<bool, float>, LobeTables> tables;
-    return tables;
-}
-std::deque<std::string>& table_names() {
-    static std::deque<std::string> names;
-    return names;
+// Per-lobe tables for the last kPhaseLobeCacheSize lobes: animating g builds
+// new ones and drops the oldest (issue 27, item 10: they used to pile up).
+constexpr size_t kPhaseLobeCacheSize = 8;
+using LobeKey = std::pair<bool, float>;  // (rayleigh, g)
+TableCache<LobeKey>& lobe_cache(bool glow) {
+    static TableCache<LobeKey> moments(kPhaseLobeCacheSize), glows(kPhaseLobeCacheSize);
+    return glow ? glows : moments;
 }
 
 Table2D build_phase_moment_table(const PhaseLobe& lobe) {
@@ -173,20 +164,14 @@ Table2D build_phase_moment_table(const PhaseLobe& lobe) {
     return t;
 }
 
-const Table2D& lobe_table(const PhaseLobe& lobe, bool glow) {
-    std::lock_guard<std::mutex> lock(lobe_mutex);
-    LobeTables& entry = lobe_tables()[{lobe.rayleigh, lobe.rayleigh ? 0.0f : lobe.g}];
-    std::unique_ptr<Table2D>& slot = glow ? entry.glow : entry.moments;
-    if (!slot) {
-        table_names().push_back(lobe_name(glow ? "phase_glow" : "phase_moments", lobe));
-        const char* name = table_names().back().c_str();
-        slot = std::make_unique<Table2D>(timed_build(name, [&] {
+std::shared_ptr<const Table2D> lobe_table(const PhaseLobe& lobe, bool glow) {
+    const LobeKey key{lobe.rayleigh, lobe.rayleigh ? 0.0f : lobe.g};
+    return lobe_cache(glow).get(key, [&] {
+        return timed_build(lobe_name(glow ? "phase_glow" : "phase_moments", lobe), [&] {
             return glow ? build_phase_glow_table(lobe, shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY)
                         : build_phase_moment_table(lobe);
-        }));
-        register_table(*slot);
-    }
-    return *slot;
+        });
+    });
 }
 
 }  // namespace
@@ -213,8 +198,8 @@ double phase_surface_glow_exact(const PhaseLobe& lobe, double optical_distance, 
     return sum;
 }
 
-const Table2D& phase_moment_table(const PhaseLobe& lobe) { return lobe_table(lobe, false); }
-const Table2D& phase_glow_table(const PhaseLobe& lobe) { return lobe_table(lobe, true); }
+std::shared_ptr<const Table2D> phase_moment_table(const PhaseLobe& lobe) { return lobe_table(lobe, false); }
+std::shared_ptr<const Table2D> phase_glow_table(const PhaseLobe& lobe) { return lobe_table(lobe, true); }
 
 double phase_airlight_bound(const PhaseLobe& lobe) { return phase_tail(lobe, 0.0, 0.5 * numerics::kPi); }
 

@@ -114,5 +114,7 @@ def table_stats() -> dict[str, dict[str, Any]]:
     scene with lamps in a scattering medium or a sky over an atmosphere or surfaces is
     rendered. The sky table ("sky_phase", effects/daytime/docs/daytime.md) is rebuilt when the sky or
     the species' phase functions change: ``builds`` counts its builds, the other
-    fields describe the last one."""
+    fields describe the last one. ``resident``: how many of the tables of that name are
+    in memory now; the tables of an animated parameter (a phase lobe's g, the sky) are
+    cached for the last 8 values, the least recently used dropped first."""
     return dict(_core.tables_built())

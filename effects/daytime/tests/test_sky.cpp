@@ -53,7 +53,8 @@ double table_value(const Table2D& t, int column, int row, int kernel) {
 void check_overcast_closed_forms(bool print) {
     shader::SpeciesGpu species[shader::SPECIES_COUNT];
     species_with(0.0f, 0.5f, species);
-    const Table2D& t = sky_phase_table(overcast(), species, true);
+    const auto table = sky_phase_table(overcast(), species, true);
+    const Table2D& t = *table;
     std::printf("overcast sky table %dx%d built in %.3f s\n", t.width, t.height, t.build_seconds);
     double worst_iso = 0.0, worst_ray = 0.0, worst_cos = 0.0;
     for (int i = 0; i < t.width; i += 3) {
@@ -101,7 +102,8 @@ void check_uniform_sky_normalisation(bool print) {
     for (float g : {0.3f, 0.7f, 0.87f, -0.5f}) {
         shader::SpeciesGpu species[shader::SPECIES_COUNT];
         species_with(g, g, species);
-        const Table2D& t = sky_phase_table(gpu, species, true);
+        const auto table = sky_phase_table(gpu, species, true);
+        const Table2D& t = *table;
         const int ne = shader::SKY_TABLE_N_ELEVATION;
         for (int row = 0; row < ne; ++row) {
             const double sum = table_value(t, 0, row, 1) + table_value(t, 0, ne - 1 - row, 1);
@@ -126,7 +128,8 @@ void check_sun_sky_table() {
     CHECK(sky_has_azimuth(gpu));
     shader::SpeciesGpu species[shader::SPECIES_COUNT];
     species_with(0.7f, 0.87f, species);
-    const Table2D& t = sky_phase_table(gpu, species, true);
+    const auto table = sky_phase_table(gpu, species, true);
+    const Table2D& t = *table;
     std::printf("CIE 12 sky table %dx%d built in %.3f s\n", t.width, t.height, t.build_seconds);
     CHECK(t.height == shader::SKY_TABLE_N_ELEVATION * shader::SKY_TABLE_N_AZIMUTH);
     // Node values against the same rule evaluated directly at a few directions.

@@ -171,7 +171,8 @@ void test_quadrature_matches_direct_integral() {
 // rounding (the design reduces exactly at k = 1; scenes with g = 0 take the
 // isotropic tables themselves).
 void test_g0_slice_is_the_isotropic_tables() {
-    const Table2D& slice = phase_moment_table(hg(0.0));
+    const auto slice_table = phase_moment_table(hg(0.0));
+    const Table2D& slice = *slice_table;
     const Table2D& tail = airlight_tail_table();
     const Table2D& spot = spot_moment_table();
     double worst_s = 0.0, worst_m = 0.0;
@@ -194,7 +195,8 @@ struct SliceErrors {
 // normalisers (the scale that the spot tail's terms carry).
 SliceErrors slice_errors(const PhaseLobe& l, int samples, std::mt19937& rng) {
     shader::PhaseSampler sampler;
-    sampler.moments = &phase_moment_table(l);
+    const auto table = phase_moment_table(l);
+    sampler.moments = table.get();
     sampler.frame.phase_lobe0 = phase_lobe_gpu(l, 1.0f);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     SliceErrors e;
@@ -227,7 +229,7 @@ void test_slices_within_budget() {
         CHECK_MSG(e.tail < (extreme ? 1e-2 : 1e-3), label(l) + " tail " + std::to_string(e.tail));
         CHECK_MSG(e.m1 < (extreme ? 0.1 : 2e-3), label(l) + " M1 " + std::to_string(e.m1));
         CHECK_MSG(e.m2 < (extreme ? 0.15 : 2e-2), label(l) + " M2 " + std::to_string(e.m2));
-        for (float v : phase_moment_table(l).texels) CHECK(std::isfinite(v));
+        for (float v : phase_moment_table(l)->texels) CHECK(std::isfinite(v));
     }
 }
 
@@ -236,7 +238,8 @@ void test_slices_within_budget() {
 // slice's maximum are skipped (as for the isotropic table).
 double glow_slice_error(const PhaseLobe& l, int samples, std::mt19937& rng) {
     shader::PhaseSampler sampler;
-    sampler.glow = &phase_glow_table(l);
+    const auto table = phase_glow_table(l);
+    sampler.glow = table.get();
     const shader::PhaseLobeGpu gpu = phase_lobe_gpu(l, 1.0f);
     const double g_max = std::exp(double(*std::max_element(sampler.glow->texels.begin(), sampler.glow->texels.end())));
     std::uniform_real_distribution<double> unit(0.0, 1.0);
@@ -290,17 +293,17 @@ void print_analysis() {
     for (const PhaseLobe& l : test_lobes()) {
         const SliceErrors e = slice_errors(l, 20000, rng);
         std::printf("%-10s %10.1e %10.1e %10.1e %10.3f\n", label(l).substr(0, 10).c_str(), e.tail, e.m1, e.m2,
-                    phase_moment_table(l).build_seconds);
+                    phase_moment_table(l)->build_seconds);
     }
     std::printf("phase glow slices (%d x %d log G): max relative error over 400 random (T, theta_s)\n",
                 shader::SURFACE_GLOW_NX, shader::SURFACE_GLOW_NY);
     for (const PhaseLobe& l : {hg(-0.9), hg(-0.5), hg(0.5), hg(0.85), hg(0.95), hg(0.99), rayleigh()}) {
         const double e = glow_slice_error(l, 400, rng);
-        std::printf(
-            "%-10s %10.1e  build %.3f s, max G %.3f, int_0^{pi/2} P dt %.4f\n", label(l).substr(0, 10).c_str(), e,
-            phase_glow_table(l).build_seconds,
-            std::exp(double(*std::max_element(phase_glow_table(l).texels.begin(), phase_glow_table(l).texels.end()))),
-            phase_airlight_bound(l));
+        const auto glow = phase_glow_table(l);
+        std::printf("%-10s %10.1e  build %.3f s, max G %.3f, int_0^{pi/2} P dt %.4f\n", label(l).substr(0, 10).c_str(),
+                    e, glow->build_seconds,
+                    std::exp(double(*std::max_element(glow->texels.begin(), glow->texels.end()))),
+                    phase_airlight_bound(l));
     }
 }
 
