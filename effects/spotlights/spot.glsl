@@ -17,9 +17,11 @@ float spot_profile_formula(SpotLightGpu s, float ct, float st2) {
     return max((1.0f - q) * cos_difference / s.cone.y, 0.0f) + q;
 }
 
-// I(theta) / I0 for cos theta = ct and sin^2 theta = st2, 0 outside the cone.
+// I(theta) / I0 for cos theta = ct and sin^2 theta = st2, 0 outside the cone:
+// inside is ct >= 0 and sin^2 theta <= sin^2 A (A <= 90 degrees), not ct >=
+// cos A, which float32 rounds to ct >= 1 for cones below about 0.02 degree.
 float spot_profile(SpotLightGpu s, float ct, float st2) {
-    return ct < s.axis_cos.w ? 0.0f : spot_profile_formula(s, ct, st2);
+    return ct >= 0.0f && st2 <= s.cone.x ? spot_profile_formula(s, ct, st2) : 0.0f;
 }
 
 // I(theta) / I0 in the emission direction `dir` (unit) from the spot.
@@ -79,11 +81,16 @@ SpotRay spot_ray_frame(vec3 rel, vec3 axis, vec3 dir, float h_floor) {
 }
 
 // True when tau lies in the forward nappe of the cone (the mirror nappe of
-// the quadratic is rejected here).
+// the quadratic is rejected here). The point v = tau d - h m from the spot
+// has axial part ax and squared distance from the axis |v x a|^2 =
+// h^2 na^2 + tau^2 na^2 + (tau ma + h da)^2, lit when that is <= sin^2 A |v|^2:
+// free of the cancellation of ax^2 >= cos^2 A |v|^2, whose cos A rounds to 1
+// in float32 for cones below about 0.02 degree (no light at all).
 bool spot_lit_at(SpotLightGpu s, SpotRay r, float tau) {
     float ax = tau * r.da - r.h * r.ma;
-    float c = s.axis_cos.w;
-    return ax >= 0.0f && ax * ax >= c * c * (tau * tau + r.h * r.h);
+    float across = tau * r.ma + r.h * r.da;
+    float off_axis2 = (tau * tau + r.h * r.h) * (r.na * r.na) + across * across;
+    return ax >= 0.0f && off_axis2 <= s.cone.x * (tau * tau + r.h * r.h);
 }
 
 // The lit part [lo, hi] (in tau) of the ray segment [tau_start, tau_end]
@@ -439,9 +446,15 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
     // part of the ray is lit or not); the midpoint rule puts cell edges there.
     vec3 n_across = n - n_to_p * to_p;
     float phi_n = dot(n_across, n_across) > 1.0e-12f ? atan(dot(n_across, e2), dot(n_across, e1)) : 0.0f;
-    bool inside = ct >= cos_a;
-    bool every_phi = inside || ct <= -cos_a;
-    float phi_m = every_phi ? PI : acos(min(sqrt(max(cos_a * cos_a - ct * ct, 0.0f)) / st, 1.0f));
+    // Inside the cone (or its mirror): sin^2 theta = st^2 <= sin^2 A. Outside,
+    // the half great circles at azimuth phi meet the cone for |sin phi| <
+    // sin A / st: phi_m = atan(sin A, sqrt(st^2 - sin^2 A)), accurate for any
+    // cone (acos(sqrt(cos^2 A - ct^2) / st) loses the narrowest cones' phi_m
+    // to the rounding of its argument near 1, and cos A rounds to 1 there).
+    bool within = st * st <= s.cone.x;
+    bool inside = ct >= 0.0f && within;
+    bool every_phi = within;
+    float phi_m = every_phi ? PI : atan(sqrt(s.cone.x), sqrt(max(st * st - s.cone.x, 0.0f)));
     // phi pieces, split where the receiver's plane makes the integrand kink
     // (phi_n +- pi/2), in the variable sv: phi = sv over the whole circle,
     // phi = phi_m sin(pi sv / 2) over the wedge sv in [-1, 1].
@@ -478,9 +491,15 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
         float x = ct;
         float y = st * cos(phi);
         float R = sqrt(x * x + y * y);
-        if (!(R > cos_a) || !(R > 0.0f)) continue;
+        // R > cos A is 1 - R^2 = st^2 sin^2 phi < sin^2 A, and the arc's half
+        // width gamma (cos gamma = cos A / R) is atan(sqrt(sin^2 A - (1 - R^2)),
+        // cos A): free of the cancellation of acos(cos A / R) near 1, where
+        // float32 rounds cos A to 1 for cones below about 0.02 degree.
+        float sin_phi = sin(phi);
+        float off_circle2 = st * st * sin_phi * sin_phi;
+        if (!(off_circle2 < s.cone.x) || !(R > 0.0f)) continue;
         float beta = atan(y, x);
-        float gamma = acos(min(cos_a / R, 1.0f));
+        float gamma = atan(sqrt(s.cone.x - off_circle2), cos_a);
         float a0 = inside ? 0.0f : max(beta - gamma, 0.0f);
         float a1 = min(beta + gamma, PI);
         if (!(a1 > a0)) {  // beta < 0: the arc is the one about beta + 2 pi
