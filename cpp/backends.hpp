@@ -28,6 +28,11 @@ struct GlDisplayJob {
     // before display_pixel (the splatted glare of the few extreme pixels that
     // the FFT does not see; glare_exact_split in display_stage.cpp).
     const Image* addend = nullptr;
+    // Ordered dithering of the bytes (display.glsl's display_quantize), with the
+    // thresholds of image pixel (x - origin, y - origin): `linear` may be the
+    // image extended by `origin` pixels on each side (the FFT glare's margin).
+    bool dither = true;
+    int origin = 0;
 };
 
 // What the GL display pass returns: RGB bytes, row 0 on top, as
@@ -62,9 +67,10 @@ public:
     void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr);
     // The display stage on the GPU (see GlDisplayJob).
     void display(const GlDisplayJob& job, GlDisplayOutput& out);
-    // The glare convolution of the display pass alone (fp32 FFT on the GPU),
-    // read back as linear radiance: compare with convolve_glare_fft.
-    void glare_convolve(const Image& in, const GlareKernel& kernel, Image& out);
+    // The glare convolution of the display pass alone (FFT on the GPU, fp32, or
+    // fp64 with double_precision), read back as linear radiance: compare with
+    // convolve_glare_fft.
+    void glare_convolve(const Image& in, const GlareKernel& kernel, Image& out, bool double_precision = false);
 
     struct State;
 

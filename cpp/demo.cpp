@@ -30,6 +30,7 @@ const char* kUsage =
     "  display stage (PNG; overrides the scene's \"display\" object):\n"
     "                     [--exposure E|auto] [--tonemap linear|loglog|reinhard|filmic]\n"
     "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
+    "                     [--dither | --no-dither]\n"
     "  the headlight experiment (a car approaching from --from to --to metres,\n"
     "  the camera tracking it; frames DIR/frame_NN_DDDDm.png):\n"
     "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n"
@@ -43,7 +44,8 @@ struct Options {
     // Display overrides (empty: the scene's).
     std::string exposure, tonemap, pupil;
     float white = 0.0f;
-    int glare = -1;  // -1: the scene's; 0 off; 1 on
+    int glare = -1;   // -1: the scene's; 0 off; 1 on
+    int dither = -1;  // -1: the scene's; 0 off; 1 on
     bool eyelashes = false;
     int frames = 12;
     double from = 2000.0, to = 20.0;
@@ -92,6 +94,10 @@ Options parse_args(int argc, char** argv) {
         }
         if (arg == "--eyelashes") {
             o.eyelashes = true;
+            continue;
+        }
+        if (arg == "--dither" || arg == "--no-dither") {
+            o.dither = arg == "--dither" ? 1 : 0;
             continue;
         }
         if (i + 1 >= argc) fail("missing value after " + arg);
@@ -159,6 +165,7 @@ airlight::DisplaySettings display_settings(const airlight::Scene& scene, const O
     if (!o.tonemap.empty()) d.curve = airlight::tone_curve_from_name(o.tonemap, "--tonemap");
     if (o.white > 0.0f) d.white = o.white;
     if (o.glare >= 0) d.glare.enabled = o.glare == 1;
+    if (o.dither >= 0) d.dither = o.dither == 1;
     if (!o.pupil.empty()) {
         d.glare.enabled = o.glare != 0;
         if (o.pupil == "auto")

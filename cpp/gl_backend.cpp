@@ -446,10 +446,10 @@ void GlBackend::display(const GlDisplayJob& job, GlDisplayOutput& out) {
     state_->display_passes->display(job, out);
 }
 
-void GlBackend::glare_convolve(const Image& in, const GlareKernel& kernel, Image& out) {
+void GlBackend::glare_convolve(const Image& in, const GlareKernel& kernel, Image& out, bool double_precision) {
     check_display_image(&in);
     State::Current current(*state_);
-    state_->display_passes->glare_convolve(in, kernel, out);
+    state_->display_passes->glare_convolve(in, kernel, out, double_precision);
 }
 
 }  // namespace airlight

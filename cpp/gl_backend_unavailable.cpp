@@ -15,6 +15,6 @@ GlBackend::GlBackend() { throw BackendUnavailable("airlight: GL backend unavaila
 GlBackend::~GlBackend() = default;
 void GlBackend::render(const FrameData&, Image&) {}
 void GlBackend::display(const GlDisplayJob&, GlDisplayOutput&) {}
-void GlBackend::glare_convolve(const Image&, const GlareKernel&, Image&) {}
+void GlBackend::glare_convolve(const Image&, const GlareKernel&, Image&, bool) {}
 
 }  // namespace airlight

@@ -24,7 +24,8 @@ inline constexpr const char kGlslPrelude[] =
     "#define CONST const\n"
     "#define OUT(T) out T\n"
     "#define INOUT(T) inout T\n"
-    "#define INLINE\n";
+    "#define INLINE\n"
+    "#define PRECISE precise\n";
 
 // A compiled shader of `stage`; throws std::runtime_error with the log on failure.
 GLuint compile_shader(GLenum stage, const std::string& source);

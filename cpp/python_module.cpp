@@ -168,8 +168,9 @@ PYBIND11_MODULE(_core, m) {
         "display",
         [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance, std::optional<float> exposure,
            const std::string& tonemap, std::optional<float> white, bool glare, std::optional<double> pupil_diameter,
-           bool eyelashes, double fov_y, airlight::Renderer* renderer) {
+           bool eyelashes, double fov_y, airlight::Renderer* renderer, bool dither) {
             airlight::DisplaySettings settings = display_settings(exposure, tonemap, white);
+            settings.dither = dither;
             settings.glare.enabled = glare;
             settings.glare.pupil_diameter_mm = pupil_diameter;
             settings.glare.eyelashes = eyelashes;
@@ -188,6 +189,7 @@ PYBIND11_MODULE(_core, m) {
             py::dict report;
             report["exposure"] = r.exposure;
             report["white"] = r.white;
+            report["dither"] = settings.dither;
             report["glare"] = r.glare;
             report["pupil_diameter"] = r.pupil_diameter_mm;
             report["glare_kernel_radius"] = r.glare_kernel_radius;
@@ -199,7 +201,8 @@ PYBIND11_MODULE(_core, m) {
             return py::make_tuple(out, report);
         },
         py::arg("radiance"), py::arg("exposure"), py::arg("tonemap"), py::arg("white"), py::arg("glare"),
-        py::arg("pupil_diameter"), py::arg("eyelashes"), py::arg("fov_y"), py::arg("renderer").none(true));
+        py::arg("pupil_diameter"), py::arg("eyelashes"), py::arg("fov_y"), py::arg("renderer").none(true),
+        py::arg("dither") = true);
     m.def(
         "auto_exposure",
         [](const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {

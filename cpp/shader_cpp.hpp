@@ -18,6 +18,9 @@ using namespace glm;
 #define INOUT(T) T&
 
 #define INLINE inline
+// GLSL's `precise`: no contraction of a product and a sum into one fused multiply-add, so that the GPU rounds
+// as the CPU build does (which targets x86-64 without FMA instructions).
+#define PRECISE
 
 #include "airlight_glsl_math.inc"
 

@@ -339,9 +339,19 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     return radiance;
 }
 
+// The smallest normal float32 (FLT_MIN): below it a float is subnormal (denormal).
+CONST float RADIANCE_MIN_NORMAL = 1.17549435e-38f;
+
+// A radiance channel with subnormal magnitude flushed to 0. Terms that underflow
+// (exp(-T) of a far lamp, a cone's edge) leave values of 1e-45..1e-38 that the CPU
+// keeps and a GPU flushes, so the backends' images would differ in those pixels;
+// radiance never carries them (effects/display/physics.md section 8). Written as a
+// comparison, so that a GPU which flushes subnormal inputs gives 0 as well.
+float flush_subnormal(float v) { return abs(v) < RADIANCE_MIN_NORMAL ? 0.0f : v; }
+
 // Linear radiance of pixel (x, row), row 0 on top: the per-pixel entry point.
 vec3 render_pixel(int x, int row) {
     vec3 radiance = ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
     if (HAS_POINT_LIGHTS || HAS_SPOT_LIGHTS) radiance = lamp_subpixel_cores(x, row, radiance);
-    return radiance;
+    return vec3(flush_subnormal(radiance.r), flush_subnormal(radiance.g), flush_subnormal(radiance.b));
 }

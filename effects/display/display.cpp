@@ -93,6 +93,23 @@ void validate_display_settings(const DisplaySettings& settings, const std::strin
 
 float auto_exposure(const Image& image, float key, int threads) {
     check_image(image);
+    const auto luminance = [](const float* p) {
+        return 0.2126 * double(p[0]) + 0.7152 * double(p[1]) + 0.0722 * double(p[2]);
+    };
+    const size_t pixels = size_t(image.width) * size_t(std::max(image.height, 0));
+    // physics.md (5.1): the floor is kAutoExposureFloor times the median luminance of the pixels with a
+    // normal (not subnormal) positive float luminance, and never below FLT_MIN: zero and subnormal pixels
+    // neither count nor move the floor.
+    std::vector<float> normal;
+    normal.reserve(pixels);
+    for (size_t i = 0; i < pixels; ++i) {
+        const double Y = luminance(&image.rgb[3 * i]);
+        if (std::isfinite(Y) && Y >= double(kMinNormalFloat)) normal.push_back(float(Y));
+    }
+    if (normal.empty()) return 1.0f;
+    const auto median = normal.begin() + std::ptrdiff_t(normal.size() / 2);
+    std::nth_element(normal.begin(), median, normal.end());
+    const double floor = std::max(kAutoExposureFloor * double(*median), double(kMinNormalFloat));
     // Per-row sums, added in row order afterwards: the result does not depend
     // on the number of threads.
     std::vector<double> row_sum(size_t(std::max(image.height, 0)), 0.0);
@@ -102,9 +119,8 @@ float auto_exposure(const Image& image, float key, int threads) {
         double sum = 0.0;
         long long count = 0;
         for (int x = 0; x < image.width; ++x) {
-            const double Y =
-                0.2126 * double(src[3 * x]) + 0.7152 * double(src[3 * x + 1]) + 0.0722 * double(src[3 * x + 2]);
-            if (Y > 0.0 && std::isfinite(Y)) {
+            const double Y = luminance(src + 3 * x);
+            if (Y >= floor && std::isfinite(Y)) {
                 sum += std::log(Y);
                 ++count;
             }
@@ -147,7 +163,8 @@ std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettin
         for (int x = 0; x < linear.width; ++x) {
             const glm::vec3 radiance(src[3 * x], src[3 * x + 1], src[3 * x + 2]);
             const glm::vec3 v = shader::display_pixel(radiance, exposure, curve, white);
-            for (int c = 0; c < 3; ++c) dst[3 * x + c] = std::uint8_t(std::lround(255.0f * v[c]));
+            const float t = settings.dither ? shader::display_dither_threshold(x, row) : 0.5f;
+            for (int c = 0; c < 3; ++c) dst[3 * x + c] = std::uint8_t(shader::display_quantize(v[c], t));
         }
     };
     numerics::parallel_for(linear.height, display_row, threads);

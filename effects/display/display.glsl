@@ -14,6 +14,9 @@
 //      (a sodium lamp's halo stays orange instead of turning white). Channels
 //      that the scaling pushes above 1 are clipped to 1 at step 4.
 //   4. Clamp to [0, 1] and encode with the sRGB OETF (IEC 61966-2-1).
+//   5. 8 bits (display_quantize): floor(255 v + t) with the pixel's ordered
+//      dither threshold t in [0, 1) (display_dither_threshold), or t = 1/2
+//      (plain rounding) with dithering off (physics.md section 5, "Dithering").
 //
 // Every curve f(L) takes the exposed luminance L >= 0 and a white point W > 0,
 // the exposed luminance that maps to display value 1, and satisfies: f(0) = 0,
@@ -130,4 +133,27 @@ INLINE vec3 display_pixel(vec3 radiance, float exposure, int curve, float white)
     float Y = display_luminance(c);
     float scale = Y > 0.0f ? tone_curve(curve, Y, white) / Y : 0.0f;
     return vec3(srgb_oetf(c.r * scale), srgb_oetf(c.g * scale), srgb_oetf(c.b * scale));
+}
+
+// The ordered dither threshold of image pixel (x, y), in [0, 1) (physics.md section 5, "Dithering"): the
+// two-dimensional R2 low-discrepancy sequence of Roberts (2018), t = frac(a1 x + a2 y) with a1 = 1 / phi2 and
+// a2 = 1 / phi2^2 (phi2 = 1.3247..., the plastic number), in 32-bit fixed point so that both backends compute
+// the same bits: a1 = 3242174889 / 2^32, a2 = 2447445413 / 2^32; unsigned products wrap mod 2^32 in GLSL and
+// C++ alike. The top 24 bits give t exactly as a float. Along any row or column the thresholds of n
+// consecutive pixels are spread over [0, 1) with gaps below 3 / n (the three-distance theorem), so a smooth
+// ramp alternates between its two nearest 8-bit values within a few pixels instead of showing bands.
+INLINE float display_dither_threshold(int x, int y) {
+    uint h = uint(x) * 3242174889u + uint(y) * 2447445413u;
+    return float(h >> 8u) * (1.0f / 16777216.0f);
+}
+
+// One encoded channel v in [0, 1] as an 8-bit value q in 0..255 (as a float): q = floor(255 v + t), written
+// as floor(255 v) + (frac >= 1 - t) so that no sum is rounded (1 - t is exact for t = k / 2^24). t = 1/2 is
+// rounding half up (std::lround for v >= 0); a t in [0, 1) keeps 0 at 0 and 1 at 255, and the mean of q over
+// thresholds spread evenly over [0, 1) is 255 v: dithering adds no bias.
+INLINE float display_quantize(float v, float threshold) {
+    PRECISE float t = 255.0f * v;
+    PRECISE float q = floor(t);
+    PRECISE float frac = t - q;  // exact
+    return frac >= 1.0f - threshold ? q + 1.0f : q;
 }

@@ -327,8 +327,7 @@ void GlDisplayPasses::glare(const GlareKernel& kernel, int w, int h, bool dbl) {
 }
 
 // display_pixel over the w x h texture `source` into display_tex (RGBA8).
-void GlDisplayPasses::display_pass(GLuint source, int w, int h, float exposure, int curve, float white,
-                                   bool has_addend) {
+void GlDisplayPasses::display_pass(GLuint source, int w, int h, const GlDisplayJob& job, bool has_addend) {
     if (display_program == 0) {
         display_program = link_compute_program(std::string(kGlslPrelude) + shader_source("display.glsl") +
                                                shader_source("display_pass.comp"));
@@ -336,10 +335,12 @@ void GlDisplayPasses::display_pass(GLuint source, int w, int h, float exposure, 
     ensure_texture(display_tex, display_w, display_h, GL_RGBA8, w, h);
     glUseProgram(display_program);
     glProgramUniform2i(display_program, glGetUniformLocation(display_program, "u_size"), w, h);
-    set_uniform(display_program, "u_exposure", exposure);
-    set_uniform(display_program, "u_curve", curve);
-    set_uniform(display_program, "u_white", white);
+    set_uniform(display_program, "u_exposure", job.exposure);
+    set_uniform(display_program, "u_curve", job.curve);
+    set_uniform(display_program, "u_white", job.white);
     set_uniform(display_program, "u_has_addend", has_addend ? 1 : 0);
+    set_uniform(display_program, "u_dither", job.dither ? 1 : 0);
+    set_uniform(display_program, "u_origin", job.origin);
     glBindTextureUnit(0, source);
     if (has_addend) glBindTextureUnit(1, addend_tex);
     glBindImageTexture(0, display_tex, 0, GL_FALSE, 0, GL_WRITE_ONLY, GL_RGBA8);
@@ -365,7 +366,7 @@ void GlDisplayPasses::display_pass(GLuint source, int w, int h, float exposure, 
 // times the background it shows after tone mapping (measured: up to 63 LSB
 // at 161x97, auto exposure, loglog). So display() runs the FFT in double
 // (FFT_DOUBLE) when glare_needs_double predicts the fp32 noise could exceed
-// 1/8 of an 8-bit step, in fp32 otherwise. glare_convolve always uses fp32.
+// 1/8 of an 8-bit step, in fp32 otherwise. glare_convolve uses fp32 unless asked for fp64.
 void GlDisplayPasses::display(const GlDisplayJob& job, GlDisplayOutput& out) {
     const Image& image = *job.linear;
     const int w = image.width, h = image.height;
@@ -390,7 +391,7 @@ void GlDisplayPasses::display(const GlDisplayJob& job, GlDisplayOutput& out) {
         upload_addend(*job.addend);
     }
     const auto t1 = std::chrono::steady_clock::now();
-    display_pass(source, w, h, job.exposure, job.curve, job.white, has_addend);
+    display_pass(source, w, h, job, has_addend);
     glPixelStorei(GL_PACK_ALIGNMENT, 1);
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     glGetTextureImage(display_tex, 0, GL_RGB, GL_UNSIGNED_BYTE, GLsizei(out.srgb8.size()), out.srgb8.data());
@@ -399,13 +400,13 @@ void GlDisplayPasses::display(const GlDisplayJob& job, GlDisplayOutput& out) {
     check_gl_error("in the display pass");
 }
 
-void GlDisplayPasses::glare_convolve(const Image& in, const GlareKernel& kernel, Image& out) {
+void GlDisplayPasses::glare_convolve(const Image& in, const GlareKernel& kernel, Image& out, bool double_precision) {
     out.width = in.width;
     out.height = in.height;
     out.rgb.assign(in.rgb.size(), 0.0f);
     if (in.width == 0 || in.height == 0) return;
     upload_radiance(in);
-    glare(kernel, in.width, in.height, false);
+    glare(kernel, in.width, in.height, double_precision);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     glPixelStorei(GL_PACK_ROW_LENGTH, 0);
     glGetTextureImage(glare_tex, 0, GL_RGB, GL_FLOAT, GLsizei(out.rgb.size() * sizeof(float)), out.rgb.data());

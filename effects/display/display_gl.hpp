@@ -36,7 +36,7 @@ public:
     // GlBackend::display: job.linear already checked (check_display_image).
     void display(const GlDisplayJob& job, GlDisplayOutput& out);
     // GlBackend::glare_convolve: `in` already checked (check_display_image).
-    void glare_convolve(const Image& in, const GlareKernel& kernel, Image& out);
+    void glare_convolve(const Image& in, const GlareKernel& kernel, Image& out, bool double_precision);
 
 private:
     GLuint display_program = 0;
@@ -73,7 +73,7 @@ private:
     void ensure_twiddles(int log2_n);
     bool kernel_cached(const GlareKernel& k, int px, int py, bool dbl) const;
     void glare(const GlareKernel& kernel, int w, int h, bool dbl);
-    void display_pass(GLuint source, int w, int h, float exposure, int curve, float white, bool has_addend);
+    void display_pass(GLuint source, int w, int h, const GlDisplayJob& job, bool has_addend);
 };
 
 }  // namespace airlight

@@ -30,10 +30,10 @@ std::optional<double> read_pupil(const Value& v) {
     return d;
 }
 
-// The "display" object (README "Display"): exposure, tone curve, white point
-// and the eye's glare (null or absent: no glare).
+// The "display" object (README "Display"): exposure, tone curve, white point,
+// the eye's glare (null or absent: no glare) and dithering (default true).
 DisplaySettings parse_display(const SceneObject& o) {
-    o.check_keys({"exposure", "tonemap", "white", "glare"});
+    o.check_keys({"exposure", "tonemap", "white", "glare", "dither"});
     DisplaySettings d;
     if (auto v = o.opt("exposure")) {
         if (v->j.is_string()) {
@@ -60,6 +60,7 @@ DisplaySettings parse_display(const SceneObject& o) {
         if (auto p = g.opt("pupil_diameter")) d.glare.pupil_diameter_mm = read_pupil(*p);
         if (auto e = g.opt("eyelashes")) d.glare.eyelashes = read_bool(*e);
     }
+    if (auto v = o.opt("dither")) d.dither = read_bool(*v);
     return d;
 }
 
@@ -82,6 +83,7 @@ json display_to_json(const DisplaySettings& d) {
     } else {
         j["glare"] = nullptr;
     }
+    j["dither"] = d.dither;
     return j;
 }
 

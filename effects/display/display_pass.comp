@@ -1,9 +1,9 @@
 // Display pass of the GL display stage (issue 8): one invocation per pixel
 // applies display_pixel (effects/display/display.glsl: exposure, tone curve on
 // luminance, sRGB OETF) to the linear radiance and stores the 8-bit value
-// round(255 v), rounded half away from zero as std::lround in apply_display
-// (effects/display/display.cpp), as q / 255 into an RGBA8 image (the UNORM conversion of
-// q / 255 gives back q exactly). display.glsl is prepended by gl_backend.cpp.
+// display_quantize(v, t) (the pixel's ordered dither threshold t, or 1/2:
+// rounding), as in apply_display (effects/display/display.cpp), as q / 255 into an
+// RGBA8 image (the UNORM conversion of q / 255 gives back q exactly). display.glsl is prepended by gl_backend.cpp.
 
 layout(local_size_x = 16, local_size_y = 16) in;
 
@@ -16,6 +16,8 @@ uniform float u_exposure;
 uniform int u_curve;
 uniform float u_white;
 uniform bool u_has_addend;
+uniform bool u_dither;  // ordered dithering (display_quantize); off: rounding
+uniform int u_origin;   // texel p is image pixel p - u_origin (the glare's margin)
 
 void main() {
     ivec2 p = ivec2(gl_GlobalInvocationID.xy);
@@ -23,8 +25,7 @@ void main() {
     vec3 radiance = texelFetch(u_radiance, p, 0).rgb;
     if (u_has_addend) radiance += texelFetch(u_addend, p, 0).rgb;
     vec3 v = display_pixel(radiance, u_exposure, u_curve, u_white);
-    vec3 t = 255.0f * v;
-    vec3 q = floor(t);
-    q += vec3(greaterThanEqual(t - q, vec3(0.5f)));  // t - q is exact: lround for t >= 0
+    float t = u_dither ? display_dither_threshold(p.x - u_origin, p.y - u_origin) : 0.5f;
+    vec3 q = vec3(display_quantize(v.r, t), display_quantize(v.g, t), display_quantize(v.b, t));
     imageStore(u_display, p, vec4(q / 255.0f, 1.0f));
 }

@@ -501,6 +501,7 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
         job.exposure = report.exposure;
         job.curve = tone_curve_shader_id(settings.curve);
         job.white = report.white;
+        job.dither = settings.dither;
         if (plan.enabled && plan.sources > 0 && glare_prefers_sparse(linear, plan)) {
             std::string method;
             splatted = apply_glare_plan(linear, plan, threads, &method);
@@ -508,6 +509,7 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
             report.glare = method;
         } else if (plan.enabled && plan.sources > 0) {
             margin = plan.kernel->radius;
+            job.origin = margin;
             split = split_for_fft(extend_edges(linear, margin), *plan.kernel);
             job.linear = &split.clipped;
             if (!split.excess.rgb.empty()) job.addend = &split.excess;

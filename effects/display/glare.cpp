@@ -149,8 +149,23 @@ void check_options(const GlareOptions& options, double pixel_angle) {
         throw std::invalid_argument("glare: eyelash_count must be >= 0 and eyelash_width_mm > 0");
 }
 
-// Adds the pixel integrals of the PSF at `lambda` (energy per pixel), times
-// weight, into out ((2r + 1)^2 values).
+}  // namespace
+
+double glare_support_window(double rho, int radius) {
+    // physics.md section 3, "Support": 1 inside half the rim, a cos^2 fall to 0 at the rim radius + 1/2.
+    const double rim = radius + 0.5, start = 0.5 * rim;
+    if (rho <= start) return 1.0;
+    if (rho >= rim) return 0.0;
+    const double c = std::cos(0.5 * kPi * (rho - start) / (rim - start));
+    return c * c;
+}
+
+namespace {
+
+// Adds the pixel integrals of the PSF at `lambda` (energy per pixel), times weight and the round support's
+// window (glare_support_window of the pixel centre's distance), into out ((2r + 1)^2 values): the kernel is
+// round, never the (2r + 1)^2 square, whose corners reach sqrt(2) r along the diagonals but only r along the
+// axes (a square halo with a hard edge).
 void accumulate_pixel_integrals(const BilinearIntegrator& integ, int n, double dx, int radius, double pixel_angle,
                                 double lambda, double weight, std::vector<double>& out) {
     const int size = 2 * radius + 1;
@@ -163,9 +178,11 @@ void accumulate_pixel_integrals(const BilinearIntegrator& integ, int n, double d
         const double y0 = c0 + (v - 0.5) * cells, y1 = c0 + (v + 0.5) * cells;
         for (int col = 0; col < size; ++col) {
             const double u = col - radius;
+            const double window = glare_support_window(std::hypot(u, v), radius);
+            if (window <= 0.0) continue;
             const double x0 = c0 + (u - 0.5) * cells, x1 = c0 + (u + 0.5) * cells;
             // Clamped: the prefiltered interpolant may dip a little below 0 inside a dark ring.
-            out[size_t(row) * size + col] += weight * std::max(0.0, integ.integrate(x0, x1, y0, y1));
+            out[size_t(row) * size + col] += weight * window * std::max(0.0, integ.integrate(x0, x1, y0, y1));
         }
     }
 }
@@ -537,7 +554,9 @@ PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx)
     PupilAperture ap;
     ap.n = n;
     ap.dx = dx;
+    ap.disc_radius = radius;
     ap.transmission.assign(size_t(n) * n, 0.0);
+    if (!lashes.empty()) ap.lashes.assign(size_t(n) * n, 0.0);
     const double half_diag = dx * std::sqrt(0.5);
     constexpr int kSub = 16;  // supersampling of cells cut by an edge
     for (int iy = 0; iy < n; ++iy) {
@@ -547,21 +566,24 @@ PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx)
             const double r = std::hypot(x, y);
             if (r > radius + half_diag) continue;
             const bool edge = r > radius - half_diag || near_lash(x, y, half_diag);
-            double t;
+            double t, shade = 0.0;
             if (!edge) {
                 t = 1.0;
             } else {
-                int inside = 0;
+                int inside = 0, shaded = 0;
                 for (int sy = 0; sy < kSub; ++sy) {
                     const double yy = y + ((sy + 0.5) / kSub - 0.5) * dx;
                     for (int sx = 0; sx < kSub; ++sx) {
                         const double xx = x + ((sx + 0.5) / kSub - 0.5) * dx;
-                        if (xx * xx + yy * yy <= radius * radius && !opaque_lash(xx, yy)) ++inside;
+                        if (xx * xx + yy * yy > radius * radius) continue;
+                        ++(opaque_lash(xx, yy) ? shaded : inside);
                     }
                 }
                 t = double(inside) / (kSub * kSub);
+                shade = double(shaded) / (kSub * kSub);
             }
             ap.transmission[size_t(iy) * n + ix] = t;
+            if (!ap.lashes.empty()) ap.lashes[size_t(iy) * n + ix] = shade;
         }
     }
     return ap;
@@ -570,18 +592,59 @@ PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx)
 PupilSpectrum pupil_power_spectrum(const PupilAperture& aperture) {
     const int n = aperture.n;
     if (!is_pow2(n)) throw std::invalid_argument("glare: aperture grid size must be a power of two");
-    std::vector<std::complex<double>> field(aperture.transmission.begin(), aperture.transmission.end());
-    detail::fft2d(field, n, n, false, 0);
+    const bool disc = aperture.disc_radius > 0.0;
+    const bool lashes = disc && aperture.lashes.size() == size_t(n) * n;
+    std::vector<std::complex<double>> field(size_t(n) * n, cd(0.0, 0.0));
+    if (!disc || lashes) {
+        // The sampled part: the whole aperture, or only the lashes' shade inside a clear disc.
+        const std::vector<double>& sampled = disc ? aperture.lashes : aperture.transmission;
+        std::copy(sampled.begin(), sampled.end(), field.begin());
+        detail::fft2d(field, n, n, false, 0);
+        if (disc)
+            for (auto& z : field) z = -z;
+    }
+    // Light through the pupil in cells (dx^2): Parseval's total for the true 0/1 aperture.
+    double area = 0.0;
+    if (disc) {
+        // The clear disc's transform is exact (physics.md section 3, "PSF", equation 3.1):
+        //   A(f) = pi R^2 2 J1(2 pi R f) / (2 pi R f),
+        // in cells at frequency index k (f = (k - n/2) / (n dx)), times (-1)^(kx + ky): the DFT's phase for a grid
+        // whose cell n/2 is the origin. The DFT of the sampled disc instead sums the copies of A shifted by
+        // multiples of 1 / dx (aliasing of its f^-3/2 tail), which interfere destructively along the axes:
+        // 17 % too little glare there at 0.7 of the grid's range, a square-looking halo.
+        const double r = aperture.disc_radius, inv_cell_area = 1.0 / (aperture.dx * aperture.dx);
+        // A depends on |f| only: evaluated once per (|kx|, |ky|) with |kx| <= |ky| (an eighth of the grid).
+        const int h = n / 2;
+        std::vector<double> airy(size_t(h + 1) * (h + 1));
+        for (int b = 0; b <= h; ++b)
+            for (int a = 0; a <= b; ++a) {
+                const double z = 2.0 * kPi * r * std::hypot(double(a), double(b)) / (n * aperture.dx);
+                const double value = z < 1e-8 ? 1.0 : 2.0 * std::cyl_bessel_j(1.0, z) / z;
+                airy[size_t(b) * (h + 1) + a] = airy[size_t(a) * (h + 1) + b] = value;
+            }
+        const double peak = kPi * r * r * inv_cell_area;
+        for (int ky = 0; ky < n; ++ky) {
+            const int b = std::abs((ky + h) % n - h);
+            for (int kx = 0; kx < n; ++kx) {
+                const int a = std::abs((kx + h) % n - h);
+                const double sign = ((kx + ky) & 1) ? -1.0 : 1.0;
+                field[size_t(ky) * n + kx] += sign * peak * airy[size_t(b) * (h + 1) + a];
+            }
+        }
+        area = kPi * r * r * inv_cell_area;
+        if (lashes)
+            for (double t : aperture.lashes) area -= t;
+    } else {
+        // Normalised by the light through the pupil, n^2 sum(t) (Parseval, for the true 0/1 aperture), not by
+        // the grid's own total n^2 sum(t^2): the anti-aliased edge cells (0 < t < 1) stand for the box-filtered
+        // aperture, whose missing energy sum(t) - sum(t^2) is light diffracted beyond the grid's angular range
+        // (about (2/3) dx / D of the total). Normalising by the grid total would push it into the core.
+        for (double t : aperture.transmission) area += t;
+    }
     PupilSpectrum spec;
     spec.n = n;
     spec.dx = aperture.dx;
     spec.power.assign(size_t(n) * n, 0.0);
-    // Normalised by the light through the pupil, n^2 sum(t) (Parseval, for the true 0/1 aperture), not by the
-    // grid's own total n^2 sum(t^2): the anti-aliased edge cells (0 < t < 1) stand for the box-filtered
-    // aperture, whose missing energy sum(t) - sum(t^2) is light diffracted beyond the grid's angular range
-    // (about (2/3) dx / D of the total). Normalising by the grid total would push it into the core.
-    double area = 0.0;
-    for (double t : aperture.transmission) area += t;
     if (!(area > 0.0)) throw std::invalid_argument("glare: the aperture lets no light through");
     const double scale = 1.0 / (double(n) * n * area);
     for (int ky = 0; ky < n; ++ky) {

@@ -37,10 +37,22 @@ float default_white(ToneCurve curve);
 // not one of the enum's values.
 void validate_display_settings(const DisplaySettings& settings, const std::string& prefix = "display.");
 
+// Automatic exposure's floor (effects/display/physics.md section 5, equation 5.1):
+// only pixels with Y >= max(kAutoExposureFloor * Y_median, kMinNormalFloat) count,
+// Y_median the median luminance of the pixels whose luminance is a normal positive
+// float. Six decades below the median pixel: darker than the black level of any
+// curve with the median shown below white (an 8-bit sRGB step near black is
+// 3e-4 of white), so such pixels show as black yet would pull the log-average.
+constexpr double kAutoExposureFloor = 1e-6;
+// FLT_MIN: below it a float32 is subnormal (or zero).
+constexpr float kMinNormalFloat = 1.17549435e-38f;
+
 // key / exp(mean ln Y) over the pixels whose Rec. 709 luminance Y is finite
-// and > 0 (zero, negative, NaN and infinite pixels are ignored: a black sky
-// must not drag the exposure to infinity). 1 when no pixel counts. Capped at
-// 1e30. Accumulated in double.
+// and at least the floor above (zero, negative, NaN, infinite, subnormal and
+// near-zero pixels are ignored: a black sky must not drag the exposure to
+// infinity, nor 1e-40 radiance left by underflow pull it up; adding zero or
+// subnormal pixels never changes the exposure). 1 when no pixel counts.
+// Capped at 1e30. Accumulated in double.
 float auto_exposure(const Image& image, float key = kAutoExposureKey, int threads = 0);
 
 // The exposure `settings` give for `image` (manual value or auto_exposure).
@@ -51,7 +63,8 @@ float resolve_exposure(const Image& image, const DisplaySettings& settings, int 
 float tone_map_luminance(ToneCurve curve, float luminance, float white);
 
 // The tone stage alone (exposure, curve, sRGB; settings.glare is ignored):
-// width * height RGB bytes, row 0 on top, round(255 * display_pixel(...)).
+// width * height RGB bytes, row 0 on top, display_quantize(display_pixel(...))
+// with pixel (x, y)'s dither threshold (settings.dither; off: round(255 v)).
 // Validates `settings` first. threads <= 0: one per hardware thread.
 std::vector<std::uint8_t> apply_display(const Image& linear, const DisplaySettings& settings, int threads = 0);
 

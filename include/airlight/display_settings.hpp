@@ -39,6 +39,9 @@ struct DisplaySettings {
     // default (default_white). Finite and > 0.
     std::optional<float> white;
     GlareSettings glare;
+    // Ordered dithering of the 8-bit output (effects/display/physics.md section 5,
+    // "Dithering"): on by default; off: plain rounding (bands on smooth gradients).
+    bool dither = true;
 };
 
 }  // namespace airlight

@@ -48,10 +48,16 @@ struct GlareOptions {
 // The pupil's transmission on an N x N grid of spacing dx (m): cell (ix, iy)
 // is centred at ((ix - N/2) dx, (iy - N/2) dx), y up; values are the covered
 // fraction of each cell (anti-aliased edges), 0 under an eyelash.
+// disc_radius > 0 (make_pupil_aperture): the aperture is that clear disc minus `lashes` (the fraction of each
+// cell inside the disc that eyelashes shade; empty without lashes), and pupil_power_spectrum takes the disc's
+// transform exactly (effects/display/physics.md section 3) and only the lashes' by FFT. disc_radius 0: the
+// transmission alone, by FFT.
 struct PupilAperture {
     int n = 0;
     double dx = 0.0;
     std::vector<double> transmission;  // n * n, row iy, column ix
+    double disc_radius = 0.0;          // m
+    std::vector<double> lashes;        // n * n or empty
 };
 PupilAperture make_pupil_aperture(const GlareOptions& options, int n, double dx);
 
@@ -70,14 +76,21 @@ struct PupilSpectrum {
 };
 PupilSpectrum pupil_power_spectrum(const PupilAperture& aperture);
 
+// The window of the kernel's round support at distance rho (pixels) from its centre (physics.md section 3,
+// "Support"): 1 up to half the rim radius + 1/2, then cos^2 down to 0 at the rim; 0 beyond. The kernel's
+// values are the PSF's pixel integrals times this window, so the glare is round and fades out smoothly.
+double glare_support_window(double rho, int radius);
+
 // One kernel per linear sRGB channel, (2 radius + 1)^2 values each, row 0 on
-// top, the centre at (radius, radius); each channel sums to 1.
+// top, the centre at (radius, radius); each channel sums to 1. Only the pixels
+// whose centres lie within radius + 1/2 of the centre are nonzero (a disc).
 struct GlareKernel {
     int radius = 0;
     double pixel_angle = 0.0;  // radians
     std::array<std::vector<double>, 3> weights;
-    // PSF energy inside the kernel before normalising (1 - truncation). Normalising keeps the central pixel's
-    // exact integral and scales the off-centre weights up by the missing energy, which leaves the centre.
+    // PSF energy inside the kernel (through its window) before normalising (1 - truncation). Normalising keeps the
+    // central pixel's exact integral and scales the off-centre weights up by the missing energy, which leaves the
+    // centre.
     std::array<double, 3> captured{};
     std::array<double, 3> negative_clamped{};  // |negative weight| removed (XYZ->RGB), relative to the sum
     double grid_dx = 0.0;                      // aperture sampling used (m)

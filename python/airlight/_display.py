@@ -46,9 +46,11 @@ def _tonemap_args(tonemap: Any, white: Any) -> tuple[str, float | None]:
 
 
 def _display(radiance: Any, exposure: Any, tonemap: Any, white: Any, glare: Any, fov_y: Any,
-             renderer: Renderer | None) -> tuple[np.ndarray, dict[str, Any]]:
+             renderer: Renderer | None, dither: Any) -> tuple[np.ndarray, dict[str, Any]]:
     """:func:`display_report` after checking every argument (errors name it)."""
     image = _radiance_array(radiance)
+    if not isinstance(dither, bool):
+        raise TypeError(f"dither: expected a bool, got {type(dither).__name__}")
     tonemap, w = _tonemap_args(tonemap, white)
     if isinstance(exposure, str):
         if exposure != "auto":
@@ -67,13 +69,13 @@ def _display(radiance: Any, exposure: Any, tonemap: Any, white: Any, glare: Any,
         if not 0 < fov < 180:
             raise ValueError(f"fov_y: must be in (0, 180) degrees, got {fov_y!r}")
     native = renderer._active() if renderer is not None else None
-    out, report = _core.display(image, manual, tonemap, w, enabled, pupil, eyelashes, fov, native)
+    out, report = _core.display(image, manual, tonemap, w, enabled, pupil, eyelashes, fov, native, dither)
     return out, dict(report)
 
 
 def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: str = "loglog",
             white: float | None = None, glare: GlareLike = None, fov_y: float | None = None,
-            renderer: Renderer | None = None) -> np.ndarray:
+            renderer: Renderer | None = None, dither: bool = True) -> np.ndarray:
     """What the eye sees: 8-bit sRGB (uint8, shape (height, width, 3)) of linear
     radiance (float (height, width, 3), e.g. from :func:`render`), computed by
     the native display stage: on the CPU (multithreaded), or on ``renderer``'s
@@ -84,10 +86,11 @@ def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: st
     (NaN, negative and infinite values count as 0); the tone curve is applied
     to the Rec. 709 luminance ``Y = 0.2126 R + 0.7152 G + 0.0722 B`` and the
     pixel scaled by ``f(Y) / Y`` (colours keep their chromaticity; channels
-    above 1 clip); then the sRGB OETF (IEC 61966-2-1) and rounding to 8 bits.
+    above 1 clip); then the sRGB OETF (IEC 61966-2-1) and 8 bits, dithered.
 
     - ``exposure``: ``"auto"`` (default) maps the log-average luminance of
-      the pixels with finite ``Y > 0`` to the key 0.18 (Reinhard et al. 2002);
+      the pixels with finite ``Y`` at least ``1e-6`` times the median
+      luminance to the key 0.18 (Reinhard et al. 2002);
       see :func:`auto_exposure`. A number >= 0 multiplies the radiance.
     - ``tonemap``, the curve ``f`` of exposed luminance ``L`` with white point
       ``W`` (the exposed luminance shown as display value 1):
@@ -111,17 +114,23 @@ def display(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: st
       skipped (``effects/display/docs/glare.md``). Needs ``fov_y``.
     - ``fov_y``: the camera's vertical field of view in degrees (the glare's
       angle per pixel).
+    - ``dither``: ``True`` (default) quantizes each encoded value ``v`` to
+      ``floor(255 v + t)`` with an ordered threshold ``t`` in [0, 1) per pixel
+      (the R2 low-discrepancy sequence, the same on both backends), so smooth
+      gradients show no bands; ``False`` rounds, ``round(255 v)``
+      (``effects/display/physics.md`` section 5).
 
     Bad arguments raise ``TypeError``/``ValueError`` naming the argument
     (``"exposure: must be >= 0, got -1"``). :func:`display_report` returns
     what was done as well.
     """
-    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer)[0]
+    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer, dither)[0]
 
 
 def display_report(radiance: np.ndarray, *, exposure: str | float = "auto", tonemap: str = "loglog",
                    white: float | None = None, glare: GlareLike = None, fov_y: float | None = None,
-                   renderer: Renderer | None = None) -> tuple[np.ndarray, dict[str, Any]]:
+                   renderer: Renderer | None = None,
+                   dither: bool = True) -> tuple[np.ndarray, dict[str, Any]]:
     """:func:`display` and what it did: ``exposure`` and ``white`` used,
     ``glare`` (``"off"``, ``"skipped"`` when no pixel is bright enough,
     ``"sparse"`` (splats on the CPU, on either backend), ``"fft"`` on the
@@ -131,7 +140,7 @@ def display_report(radiance: np.ndarray, *, exposure: str | float = "auto", tone
     spread, see ``effects/display/docs/glare.md``), ``glare_error_bound`` (radiance: no pixel
     differs from the exact convolution by more), ``glare_sources`` (pixels
     spread), ``glare_ms`` and ``tone_ms``."""
-    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer)
+    return _display(radiance, exposure, tonemap, white, glare, fov_y, renderer, dither)
 
 
 def display_scene(radiance: np.ndarray, scene: SceneLike, *, renderer: Renderer | None = None) -> np.ndarray:
@@ -141,14 +150,17 @@ def display_scene(radiance: np.ndarray, scene: SceneLike, *, renderer: Renderer 
     settings = loaded["display"]
     return display(radiance, exposure=settings["exposure"], tonemap=settings["tonemap"],
                    white=settings.get("white"), glare=settings.get("glare"),
-                   fov_y=loaded["camera"]["fov_y"], renderer=renderer)
+                   fov_y=loaded["camera"]["fov_y"], renderer=renderer, dither=settings["dither"])
 
 
 def auto_exposure(radiance: np.ndarray) -> float:
     """The exposure ``display(radiance, exposure="auto")`` uses: 0.18 divided by
     the log-average Rec. 709 luminance ``exp(mean(ln Y))`` over the pixels with
-    finite ``Y > 0`` (black, negative, NaN and infinite pixels are ignored); 1.0
-    when there is none."""
+    finite ``Y >= max(1e-6 * Y_median, FLT_MIN)``, ``Y_median`` the median of the
+    luminances that are normal positive floats (black, negative, NaN, infinite,
+    subnormal and near-zero pixels are ignored; adding zero or subnormal pixels
+    never changes the exposure; ``effects/display/physics.md`` equation 5.1);
+    1.0 when there is none."""
     return float(_core.auto_exposure(_radiance_array(radiance)))
 
 

@@ -148,8 +148,12 @@ void test_auto_exposure() {
         // Before the curve: with the linear curve and white 1, grey maps to sRGB(0.18) = 118.
         DisplaySettings s;
         s.curve = ToneCurve::linear;
+        s.dither = false;
         const std::vector<std::uint8_t> out = apply_display(uniform_image(3, 2, L, L, L), s);
         CHECK_MSG(out[0] == 118 && out[1] == 118 && out[2] == 118, std::to_string(out[0]));
+        // Dithered: 117.65 shows as 117 or 118.
+        s.dither = true;
+        for (std::uint8_t v : apply_display(uniform_image(3, 2, L, L, L), s)) CHECK(v == 117 || v == 118);
     }
     // Zero, negative, NaN and infinite pixels are ignored; an all-black image gets 1.
     Image img = uniform_image(4, 4, 2.0f, 2.0f, 2.0f);
@@ -211,6 +215,7 @@ void test_apply_display() {
     lin.curve = ToneCurve::linear;
     lin.exposure_mode = ExposureMode::manual;
     lin.exposure = 1.0f;
+    lin.dither = false;
     const Image grey = uniform_image(2, 2, 0.5f, 0.5f, 0.5f);
     CHECK(apply_display(grey, lin)[0] == 188);  // round(255 * 0.7353569)
     CHECK(apply_display(uniform_image(0, 0, 0, 0, 0), lin).empty());

@@ -32,9 +32,9 @@ def _hdr_image(rng: np.random.Generator, height: int, width: int, sources: int, 
 
 def test_scene_display_object_defaults_and_round_trip() -> None:
     loaded = airlight.load_scene(make_scene())
-    assert loaded["display"] == {"exposure": "auto", "tonemap": "loglog", "glare": None}
+    assert loaded["display"] == {"exposure": "auto", "tonemap": "loglog", "glare": None, "dither": True}
     display = {"exposure": 0.25, "tonemap": "reinhard", "white": 8.0,
-               "glare": {"pupil_diameter": 2.5, "eyelashes": True}}
+               "glare": {"pupil_diameter": 2.5, "eyelashes": True}, "dither": False}
     loaded = airlight.load_scene(make_scene(display=display))
     assert loaded["display"] == display
     assert airlight.load_scene(loaded)["display"] == display
@@ -330,3 +330,26 @@ def test_dark_subpixel_lamps_never_make_radiance_negative(renderer) -> None:
     image = renderer.render(scene)
     assert image.min() >= 0.0
     assert image.min() < 0.5  # the dark cores do hide the background
+
+
+FLT_MIN = np.finfo(np.float32).tiny
+
+
+def test_spotlights_crossing_radiance_has_no_denormals_and_one_exposure(renderer_cache) -> None:
+    """Issue 17: on a small film the spotlights in a medium of 0.02 /m left subnormal radiance
+    (1e-45..1e-38) on the CPU, flushed on GL, so the automatic exposures differed (3549 against 972 at
+    80 x 60) and so did the images. Radiance carries no subnormals (shaders/shading.glsl), and the
+    exposure's floor (physics.md (5.1)) ignores what is left near zero: one exposure on both backends."""
+    scene = airlight.preset("spotlights_crossing_002")
+    exposures = []
+    for name in ("cpu", "gl"):
+        try:
+            r = renderer_cache(name)
+        except pytest.skip.Exception:
+            continue
+        radiance = r.render(scene, width=80, height=60)
+        subnormal = (radiance != 0) & (np.abs(radiance) < FLT_MIN)
+        assert not subnormal.any(), f"{name}: {int(subnormal.sum())} subnormal values"
+        exposures.append(airlight.auto_exposure(radiance))
+    if len(exposures) == 2:
+        assert exposures[1] == pytest.approx(exposures[0], rel=1e-3)

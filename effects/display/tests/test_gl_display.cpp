@@ -21,6 +21,7 @@
 #include "airlight/glare.hpp"
 #include "backends.hpp"
 #include "check.hpp"
+#include "glare_shape.hpp"
 #include "shader_cpp.hpp"
 
 using namespace airlight;
@@ -337,6 +338,37 @@ void test_too_large(GlBackend& gl) {
 
 }  // namespace
 
+// Issue 17 on the GPU: the FFT glare (fp64, so that its roundoff stays far below the faint rim) of one
+// bright pixel is round and falls off along rays, like the CPU's (test_glare.cpp,
+// test_glare_of_a_pixel_is_round; the same cases).
+void test_glare_of_a_pixel_is_round(GlBackend& gl) {
+    struct Case {
+        double pupil_mm, fov_y;
+        int rows, min_distance;
+    };
+    for (const Case& cs : {Case{1.0, 14.0, 360, 6}, Case{4.0, 60.0, 360, 1}}) {
+        GlareOptions options;
+        options.pupil_diameter_mm = cs.pupil_mm;
+        const GlareKernel k = glare_kernel_rgb(options, camera_pixel_angle(cs.fov_y, cs.rows));
+        const int r = k.radius, n = 2 * r + 9, c0 = n / 2;
+        Image one{n, n, std::vector<float>(size_t(n) * n * 3, 0.0f)};
+        for (int c = 0; c < 3; ++c) one.rgb[(size_t(c0) * n + c0) * 3 + c] = 1.0f;
+        Image out;
+        gl.glare_convolve(one, k, out, true);
+        for (int c = 0; c < 3; ++c) {
+            const double peak = out.rgb[(size_t(c0) * n + c0) * 3 + c];
+            const glare_shape::Shape s = glare_shape::measure(out, c0, c0, c, cs.min_distance, 1e-10 * peak);
+            std::printf(
+                "round glare (GPU FFT, fp64), %.0f mm, channel %d: asymmetry %.2e at %.1f px, %d rises, "
+                "support %.1f px (radius %d)\n",
+                cs.pupil_mm, c, s.asymmetry, s.asymmetry_at, s.rises, s.support, r);
+            CHECK(s.asymmetry <= 0.01);
+            CHECK(s.rises == 0);
+            CHECK(s.support <= r + 0.5);
+        }
+    }
+}
+
 int main() {
     std::string reason;
     if (!gl_backend_available(&reason)) {
@@ -367,5 +399,6 @@ int main() {
     test_display_with_glare(gl, k97);
     test_hdr_display_with_glare(gl, k97);
     test_hdr_display_with_glare(gl, k1080);
+    test_glare_of_a_pixel_is_round(gl);
     return airlight_test::test_result("test_gl_display");
 }
