@@ -12,6 +12,7 @@
 #include <cstring>
 #include <glm/geometric.hpp>
 #include <glm/vec3.hpp>
+#include <limits>
 #include <optional>
 #include <string>
 #include <utility>
@@ -83,8 +84,17 @@ Camera parse_camera(const SceneObject& o) {
     c.fov_y_degrees = read_positive(o.req("fov_y"), 180.0, false);
     // Degeneracy, on the stored float values.
     glm::dvec3 position(c.position), view = glm::dvec3(c.look_at) - position, up(c.up);
-    if (glm::length(view) < 1e-6 * std::max(1.0, glm::length(position)))
-        fail(Kind::value, join_path(o.path, "look_at"), "look_at equals position");
+    // The view direction must stand above the float32 rounding of the two
+    // points' coordinates (a few units in the last place of the largest).
+    const double coordinate =
+        std::max({1.0, std::abs(position.x), std::abs(position.y), std::abs(position.z), double(std::abs(c.look_at.x)),
+                  double(std::abs(c.look_at.y)), double(std::abs(c.look_at.z))});
+    const double resolution = 4.0 * double(std::numeric_limits<float>::epsilon()) * coordinate;
+    if (glm::length(view) == 0.0) fail(Kind::value, join_path(o.path, "look_at"), "look_at equals position");
+    if (glm::length(view) < resolution)
+        fail(Kind::value, join_path(o.path, "look_at"),
+             "look_at is closer to position than float32 resolves at these coordinates (" + format_number(resolution) +
+                 " m); move it further away");
     double up_length = glm::length(up);
     if (up_length == 0 || glm::length(glm::cross(glm::normalize(view), up)) < 1e-6 * up_length)
         fail(Kind::value, join_path(o.path, "up"), "up is zero or parallel to the view direction");
@@ -120,7 +130,7 @@ Phase parse_phase(const SceneObject& o) {
 Medium parse_medium(const SceneObject& o) {
     o.check_keys({"sigma_t", "albedo", "phase"});
     Medium m;
-    m.sigma_t = read_rgb(o.req("sigma_t"));
+    m.sigma_t = read_rgb(o.req("sigma_t"), max_extinction);
     if (auto v = o.opt("albedo")) m.albedo = read_rgb(*v, 1.0);
     if (auto v = o.opt("phase")) m.phase = parse_phase(SceneObject(*v));
     return m;

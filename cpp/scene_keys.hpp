@@ -24,6 +24,13 @@ using Kind = SceneError::Kind;
 using Names = std::vector<std::string>;
 
 constexpr double infinity = std::numeric_limits<double>::infinity();
+// The largest intensity (W/sr), radiance (W/(m^2 sr)) or irradiance (W/m^2) a
+// scene may give: 1e30 keeps every sum and product the renderer forms of them
+// below float32's 3.4e38 (values near that limit gave NaN and Inf).
+constexpr double max_radiometric = 1e30;
+// The largest extinction coefficient (1/m): a visibility of 3.9 mm. Beyond
+// it nothing is visible at all, and sigma_t near 1e37 gave NaN.
+constexpr double max_extinction = 1e3;
 
 template <class E>
 using NameTable = std::vector<std::pair<const char*, E>>;
@@ -78,8 +85,9 @@ glm::vec3 read_vec3(const Value& v);
 // precision are kept as given, so that reloading a written scene gives the
 // same bits.
 glm::vec3 read_direction(const Value& v, const char* zero_message);
-// An RGB value: a number (all channels) or a list of exactly 3, each in [0, hi].
-Rgb read_rgb(const Value& v, double hi = infinity);
+// An RGB value: a number (all channels) or a list of exactly 3, each in [0, hi]
+// (by default a radiometric quantity, at most max_radiometric).
+Rgb read_rgb(const Value& v, double hi = max_radiometric);
 // A Henyey-Greenstein asymmetry: a number in (-1, 1). One that rounds to
 // +-1 in float32 is kept as the float just inside (rendering clamps |g| to
 // PHASE_G_LIMIT anyway), so that the written scene reloads.

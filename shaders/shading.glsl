@@ -341,6 +341,8 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
 
 // The smallest normal float32 (FLT_MIN): below it a float is subnormal (denormal).
 CONST float RADIANCE_MIN_NORMAL = 1.17549435e-38f;
+// The largest float32 (FLT_MAX).
+CONST float RADIANCE_MAX = 3.40282347e38f;
 
 // A radiance channel with subnormal magnitude flushed to 0. Terms that underflow
 // (exp(-T) of a far lamp, a cone's edge) leave values of 1e-45..1e-38 that the CPU
@@ -353,5 +355,9 @@ float flush_subnormal(float v) { return abs(v) < RADIANCE_MIN_NORMAL ? 0.0f : v;
 vec3 render_pixel(int x, int row) {
     vec3 radiance = ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
     if (HAS_POINT_LIGHTS || HAS_SPOT_LIGHTS) radiance = lamp_subpixel_cores(x, row, radiance);
-    return vec3(flush_subnormal(radiance.r), flush_subnormal(radiance.g), flush_subnormal(radiance.b));
+    radiance = vec3(flush_subnormal(radiance.r), flush_subnormal(radiance.g), flush_subnormal(radiance.b));
+    // Saturated at the largest float, never Inf: the scene keys' bounds
+    // (max_radiometric, max_extinction in cpp/scene_keys.hpp) keep valid scenes
+    // below it; this is the net for sums of many lamps near those bounds.
+    return min(radiance, vec3(RADIANCE_MAX));
 }

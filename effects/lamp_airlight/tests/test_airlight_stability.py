@@ -414,20 +414,32 @@ def test_random_foggy_scenes_are_finite_and_non_negative(scene):
         _finite_non_negative(image, f"[{backend}]")
 
 
-@pytest.mark.parametrize("sigma_t, lamp_x", [(1e38, 3.0), (1e32, 9e6)])
+@pytest.mark.parametrize("sigma_t, lamp_x", [(1e38, 3.0), (1e32, 9e6), (1e3, 3.0), (1e3, 9e6)])
 def test_huge_extinction_does_not_crash_the_process(sigma_t, lamp_x):
     """A NaN table coordinate (from sigma_t near the float limit) once indexed a table out of bounds
     on the CPU and killed the process (issue "Reliability", item 1); table lookups now take a NaN
-    coordinate as 0. Run in a subprocess: a crash must show as a failure, not end the suite."""
+    coordinate as 0, and sigma_t is bounded by 1e3 /m (a visibility of 3.9 mm): beyond, a clear
+    ValueError; at the bound, a finite image on both backends. Run in a subprocess: a crash must
+    show as a failure, not end the suite."""
     import subprocess
     import sys
     code = (
-        "import airlight\n"
+        "import airlight, numpy as np\n"
         "s = {'film': {'width': 1, 'height': 1}, 'camera': {'position': [0, 1.7, 0], 'look_at': [0, 1, -10],"
         " 'up': [0, 1, 0], 'fov_y': 60},"
         f" 'medium': {{'sigma_t': {sigma_t!r}, 'albedo': 1.0}}, 'lights': [{{'type': 'point',"
         f" 'position': [{lamp_x!r}, 5, -8], 'intensity': 100, 'radius': 0.1}}]}}\n"
-        "airlight.render(s, backend='cpu')\n"
+        "try:\n"
+        "    for b in airlight.available_backends():\n"
+        "        image = airlight.render(s, backend=b)\n"
+        "        assert np.isfinite(image).all() and (image >= 0).all(), (b, image)\n"
+        "    print('rendered')\n"
+        "except ValueError as e:\n"
+        "    print('refused:', e)\n"
     )
     result = subprocess.run([sys.executable, "-c", code], capture_output=True, text=True, timeout=120)
     assert result.returncode == 0, result.stderr[-2000:]
+    if sigma_t > 1e3:
+        assert result.stdout.startswith("refused: medium.sigma_t: must be <= 1000"), result.stdout
+    else:
+        assert result.stdout.strip() == "rendered", result.stdout

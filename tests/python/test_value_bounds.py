@@ -1,0 +1,65 @@
+"""Extreme values (issue 27, items 1 and 9): values near float32's limit gave NaN or Inf
+(sigma_t from 1e37, RGB values near 3e38 for lamps, sky and sun); they are now bounded
+(intensities, radiances and irradiances by 1e30, sigma_t by 1000 /m: README, "Scene
+format"), and at those bounds every backend renders finite, non-negative images. A
+camera at (1e7, 0, 1e7) looking at a point 10 m away was refused as 'equal to its
+position'; the test is now the float32 resolution of the coordinates."""
+
+from __future__ import annotations
+
+import numpy as np
+import pytest
+
+import airlight
+
+
+def lamp_scene(sigma_t: float, intensity: float, radius: float = 0.05, background: float = 0.0) -> dict:
+    return {"film": {"width": 6, "height": 4},
+            "camera": {"position": [0, 1.7, 0], "look_at": [0, 1, -10], "up": [0, 1, 0], "fov_y": 60},
+            "medium": {"sigma_t": sigma_t, "albedo": 1.0}, "background": background,
+            "lights": [{"type": "point", "position": [0.5, 1.5, -3], "intensity": intensity,
+                        "radius": radius},
+                       {"type": "spot", "position": [-1, 3, -4], "direction": [0, -1, 0],
+                        "intensity": intensity, "cone_angle": 30}],
+            "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 1.0},
+                         {"type": "sphere", "center": [0, 1, -6], "radius": 1, "albedo": 1.0}]}
+
+
+@pytest.mark.parametrize("sigma_t", [0.0, 1e-9, 0.05, 10.0, 1e3])
+@pytest.mark.parametrize("intensity", [1e-30, 1.0, 1e30])
+def test_scenes_at_the_bounds_render_finite(sigma_t, intensity, renderer):
+    image = renderer.render(lamp_scene(sigma_t, intensity, background=1e30))
+    assert np.isfinite(image).all() and (image >= 0).all()
+
+
+def test_a_sky_and_sun_at_the_bounds_render_finite(renderer):
+    scene = airlight.load_scene("scenes/day_clear.json")
+    scene["sky"]["zenith_radiance"] = 1e30
+    scene["sun"]["irradiance"] = 1e30
+    image = renderer.render(scene, width=8, height=6)
+    assert np.isfinite(image).all() and (image >= 0).all()
+
+
+@pytest.mark.parametrize(("key", "value", "message"), [
+    (("medium", "sigma_t"), 1001.0, "medium.sigma_t: must be <= 1000"),
+    (("medium", "sigma_t"), 1e37, "medium.sigma_t: must be <= 1000"),
+    (("lights", 0, "intensity"), 3e38, "lights[0].intensity: must be <= 1e+30"),
+    (("background",), [0, 2e30, 0], "background: element 1: must be <= 1e+30"),
+])
+def test_values_past_the_bounds_are_refused_naming_the_field(key, value, message):
+    scene = lamp_scene(0.05, 1.0)
+    target = scene
+    for k in key[:-1]:
+        target = target[k]
+    target[key[-1]] = value
+    with pytest.raises(ValueError, match=message.replace("[", r"\[").replace("]", r"\]").replace("+", r"\+")):
+        airlight.load_scene(scene)
+
+
+def test_a_camera_far_out_looking_10_m_ahead_renders(renderer):
+    scene = {"film": {"width": 4, "height": 3},
+             "camera": {"position": [1e7, 0, 1e7], "look_at": [1e7, 0, 1e7 - 10], "up": [0, 1, 0],
+                        "fov_y": 60},
+             "background": 1.0}
+    image = renderer.render(scene)
+    np.testing.assert_allclose(image, 1.0)
