@@ -192,7 +192,7 @@ def test_demo_auto_backend_falls_back_to_cpu_where_gl_is_unavailable(
     (["--white", "0"], "--white"),
     (["--white", "-2"], "--white"),
     (["--sequence", "parade"], "--sequence"),
-    (["--sequence", "approaching-car", "--frames", "1"], "--frames"),
+    (["--sequence", "approaching-car", "--frames", "0"], "--frames"),
     (["--sequence", "approaching-car", "--from", "10", "--to", "20"], "--to"),
 ])
 def test_demo_bad_display_option_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
@@ -208,13 +208,57 @@ def test_demo_bad_display_object_in_the_scene_names_the_field(tmp_path: Path, sc
                            "display.glare.pupil_diameter")
 
 
+def _approaching_car() -> Path:
+    return Path(__file__).resolve().parents[2] / "scenes" / "approaching_car.json"
+
+
+@pytest.mark.parametrize(("args", "names"), [
+    (["--frames", "1", "--from", "20"], ["frame_00_0020m.png"]),
+    (["--frames", "1", "--from", "25", "--to", "10"], ["frame_00_0025m.png"]),
+    (["--frames", "2", "--from", "20", "--to", "20"], ["frame_00_0020m.png", "frame_01_0020m.png"]),
+])
+def test_demo_approaching_car_renders_a_single_distance(tmp_path: Path, args: list[str],
+                                                        names: list[str]) -> None:
+    """One frame (at --from), or --from equal to --to, is a sequence too (issue 17): at 20-25 m
+    the car's two headlights are two bright spots either side of a darker middle."""
+    out = tmp_path / "frames"
+    proc = _demo("--scene", str(_approaching_car()), "--out", str(out), "--backend", "cpu", "--sequence",
+                 "approaching-car", "--width", "64", "--height", "36", "--exposure", "1", *args)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == names
+    for name in names:
+        with Image.open(out / name) as png:
+            row = np.asarray(png.convert("RGB")).astype(int)[16:20, :, 1].max(axis=0)
+        left, right = int(np.argmax(row[:32])), 32 + int(np.argmax(row[32:]))
+        assert min(row[left], row[right]) > 150 and left < 30 and right > 33, row.tolist()
+        assert row[31:33].max() < 0.8 * min(row[left], row[right]), row.tolist()
+
+
+def test_demo_approaching_car_needs_the_car_in_the_scene(tmp_path: Path, scene_factory) -> None:
+    path = _write_scene(tmp_path, scene_factory(lights=[]))
+    proc = _demo("--scene", str(path), "--out", str(tmp_path / "frames"), "--sequence", "approaching-car")
+    _assert_one_line_error(proc, "approaching-car", "lights")
+
+
+def test_demo_renders_the_approaching_car_preset_alone(tmp_path: Path) -> None:
+    """scenes/approaching_car.json without --sequence shows the car 200 m away: two headlights
+    (not a black frame)."""
+    out = tmp_path / "car.png"
+    proc = _demo("--scene", str(_approaching_car()), "--out", str(out), "--backend", "cpu", "--width", "160",
+                 "--height", "90", "--exposure", "1")
+    assert proc.returncode == 0, proc.stderr
+    with Image.open(out) as png:
+        pixels = np.asarray(png.convert("RGB")).astype(int)
+    assert pixels.max() > 200, "the preset renders black"
+
+
 @pytest.mark.slow
 def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str) -> None:
     """The headlight experiment: one PNG per distance, named by frame and distance; at 2 km
     the two headlights are one spot in the middle, at 20 m two spots either side of a
     darker middle (1.5 m apart: 5.5 pixels each side at 14 degrees over 36 rows). Pixels 10
     times the scene's on a side hold 100 times the solid angle: exposure 1, not 0.01."""
-    scene = Path(__file__).resolve().parents[2] / "scenes" / "approaching_car.json"
+    scene = _approaching_car()
     out = tmp_path / "frames"
     proc = _demo("--scene", str(scene), "--out", str(out), "--backend", backend, "--sequence",
                  "approaching-car", "--frames", "3", "--width", "64", "--height", "36", "--exposure", "1")
