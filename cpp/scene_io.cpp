@@ -118,9 +118,16 @@ Phase parse_phase(const SceneObject& o) {
 }
 
 Medium parse_medium(const SceneObject& o) {
-    o.check_keys({"sigma_t", "albedo", "phase"});
+    o.check_keys({"sigma_t", "visibility", "albedo", "phase"});
     Medium m;
-    m.sigma_t = read_rgb(o.req("sigma_t"));
+    // Exactly one of sigma_t and the visibility (Koschmieder, as the aerosol's).
+    const Either given = read_either(o, "sigma_t", "sigma_t (1/m)", "visibility", "visibility (m)");
+    if (given.first) {
+        m.sigma_t = read_rgb(given.value);
+    } else {
+        m.visibility = read_visibility(given.value);
+        m.sigma_t = Rgb(visibility_extinction(m.visibility));
+    }
     if (auto v = o.opt("albedo")) m.albedo = read_rgb(*v, 1.0);
     if (auto v = o.opt("phase")) m.phase = parse_phase(SceneObject(*v));
     return m;
@@ -283,9 +290,14 @@ json scene_to_json_value(const Scene& s) {
                    {"up", json_vec3(s.camera.up)},
                    {"fov_y", json_number(s.camera.fov_y_degrees)}};
     if (s.has_medium) {
-        j["medium"] = {{"sigma_t", json_vec3(s.medium.sigma_t)},
-                       {"albedo", json_vec3(s.medium.albedo)},
-                       {"phase", phase_to_json(s.medium.phase)}};
+        // By its visibility where the scene gave one and sigma_t is still its value.
+        const bool by_visibility =
+            s.medium.visibility > 0.0f && s.medium.sigma_t == Rgb(visibility_extinction(s.medium.visibility));
+        j["medium"] = {{"albedo", json_vec3(s.medium.albedo)}, {"phase", phase_to_json(s.medium.phase)}};
+        if (by_visibility)
+            j["medium"]["visibility"] = json_number(s.medium.visibility);
+        else
+            j["medium"]["sigma_t"] = json_vec3(s.medium.sigma_t);
     } else {
         j["medium"] = nullptr;
     }

@@ -278,6 +278,37 @@ const std::vector<BadCase> bad_cases = {
      Kind::value, "medium.albedo", "must be <= 1"},
     {"medium albedo < 0", [](json& j) { j["medium"]["albedo"] = -0.1; }, Kind::value, "medium.albedo", "must be >= 0"},
     {"medium typo", [](json& j) { j["medium"]["sigma"] = 1; }, Kind::value, "medium.sigma", "did you mean 'sigma_t'?"},
+    // A medium given by its visibility (issue 17): exactly one of sigma_t and visibility.
+    {"medium both amounts", [](json& j) { j["medium"]["visibility"] = 100; }, Kind::value, "medium.visibility",
+     "give either sigma_t (1/m) or visibility (m), not both"},
+    {"medium without amount", [](json& j) { j["medium"].erase("sigma_t"); }, Kind::value, "medium.sigma_t",
+     "or visibility (m)"},
+    {"medium visibility zero",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = 0;
+     },
+     Kind::value, "medium.visibility", "must be > 0"},
+    {"medium visibility negative",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = -50;
+     },
+     Kind::value, "medium.visibility", "must be > 0"},
+    {"medium visibility huge",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = 2e9;
+     },
+     Kind::value, "medium.visibility", "must be <= 1e+09"},
+    {"medium visibility list",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = {100, 100, 100};
+     },
+     Kind::type, "medium.visibility", "expected a number"},
+    {"medium visibility typo", [](json& j) { j["medium"]["visibilty"] = 100; }, Kind::value, "medium.visibilty",
+     "did you mean 'visibility'?"},
     {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "mie"; }, Kind::value, "medium.phase.type",
      "isotropic"},
     {"hg without g", [](json& j) { j["medium"]["phase"]["type"] = "hg"; }, Kind::value, "medium.phase.g",
@@ -996,6 +1027,24 @@ void test_round_trip() {
     airlight::Scene g_scene = airlight::parse_scene_json(near_one);
     CHECK(g_scene.medium.phase.g < 1.0f && g_scene.medium.phase.g > 0.9999f);
     CHECK(same_scene(g_scene, airlight::parse_scene(airlight::scene_to_json(g_scene))));
+
+    // A medium given by its visibility (issue 17): sigma_t = 3.912 / V on every channel,
+    // written back by its visibility (not sigma_t: the two together are refused), and reloaded
+    // bit for bit; once sigma_t is changed it is written as sigma_t.
+    json foggy = base_scene();
+    foggy["medium"].erase("sigma_t");
+    foggy["medium"]["visibility"] = 97.8;
+    airlight::Scene fog = airlight::parse_scene_json(foggy);
+    CHECK(fog.has_medium && fog.medium.visibility == 97.8f);
+    CHECK(same(fog.medium.sigma_t, glm::vec3(float(3.912 / double(97.8f)))));
+    CHECK(std::abs(fog.medium.sigma_t.y - 0.04f) < 1e-6f);
+    json fog_json = airlight::scene_to_json_value(fog);
+    CHECK(fog_json["medium"]["visibility"] == 97.8 && !fog_json["medium"].contains("sigma_t"));
+    const airlight::Scene fog_again = airlight::parse_scene(airlight::scene_to_json(fog));
+    CHECK(same_scene(fog, fog_again) && fog_again.medium.visibility == fog.medium.visibility);
+    fog.medium.sigma_t.x = 0.5f;
+    json edited = airlight::scene_to_json_value(fog);
+    CHECK(!edited["medium"].contains("visibility") && edited["medium"]["sigma_t"][0] == 0.5);
 
     // No medium: written as null.
     airlight::Scene clear = s;

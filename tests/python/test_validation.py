@@ -264,6 +264,39 @@ def test_valid_base_scene_loads_and_is_normalised() -> None:
     assert loaded["medium"]["sigma_t"] == pytest.approx([0.05] * 3)
 
 
+def _foggy(**medium: object) -> dict:
+    scene = copy.deepcopy(VALID)
+    scene["medium"] = {k: v for k, v in {**scene["medium"], **medium}.items() if v is not None}
+    return scene
+
+
+def test_medium_given_by_its_visibility_renders_as_koschmieder_sigma_t() -> None:
+    """medium.visibility V (m) is the night fog's alternative to sigma_t (issue 17), as for the
+    daytime aerosol: sigma_t = 3.912 / V on every channel; the loaded scene keeps the
+    visibility (not both keys, which are refused together), reloads to itself, and renders
+    exactly as the same medium given by sigma_t."""
+    by_visibility = _foggy(sigma_t=None, visibility=97.8)
+    loaded = airlight.load_scene(by_visibility)
+    assert loaded["medium"]["visibility"] == pytest.approx(97.8) and "sigma_t" not in loaded["medium"]
+    assert airlight.load_scene(loaded) == loaded
+    by_sigma = _foggy(sigma_t=float(np.float32(3.912 / np.float64(np.float32(97.8)))))
+    np.testing.assert_array_equal(airlight.render(by_visibility, backend="cpu", width=24, height=16),
+                                  airlight.render(by_sigma, backend="cpu", width=24, height=16))
+
+
+@pytest.mark.parametrize(("medium", "exc", "field", "needle"), [
+    ({"visibility": 100.0}, ValueError, "medium.visibility", "not both"),
+    ({"sigma_t": None}, ValueError, "medium.sigma_t", "visibility"),
+    ({"sigma_t": None, "visibility": 0}, ValueError, "medium.visibility", "> 0"),
+    ({"sigma_t": None, "visibility": -3.0}, ValueError, "medium.visibility", "> 0"),
+    ({"sigma_t": None, "visibility": float("nan")}, ValueError, "medium.visibility", "finite"),
+    ({"sigma_t": None, "visibility": "dense"}, TypeError, "medium.visibility", "number"),
+])
+def test_medium_visibility_errors_name_the_field(medium: dict, exc: type, field: str, needle: str) -> None:
+    with pytest.raises(exc, match=f"^{re.escape(field)}: .*{needle}"):
+        airlight.load_scene(_foggy(**medium))
+
+
 @pytest.mark.parametrize(("mutate", "exc", "field"), [b[1:] for b in BAD_SCENES], ids=BAD_IDS)
 def test_load_scene_rejects_bad_input_naming_the_field(mutate, exc, field) -> None:
     with pytest.raises(exc) as info:
