@@ -298,8 +298,7 @@ int main(int argc, char** argv) {
     } catch (const SceneError& e) {
         fail(o.scene + ": " + e.what());
     }
-    if (o.width > 0) scene.film.width = o.width;
-    if (o.height > 0) scene.film.height = o.height;
+    scene.film = resize_film(scene.film, o.width, o.height);  // one of them: the scene's aspect ratio
 
     Backend backend = Backend::cpu;
     if (o.backend == "gl") {

@@ -145,6 +145,14 @@ PYBIND11_MODULE(_core, m) {
         "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");
     m.def("load_scene_file",
           [](const std::string& path) { return airlight::scene_to_json(airlight::load_scene_file(path), -1); });
+    m.def(
+        "resize_film",
+        [](int film_width, int film_height, int width, int height) {
+            const airlight::Film f = airlight::resize_film(airlight::Film{film_width, film_height}, width, height);
+            return std::make_pair(f.width, f.height);
+        },
+        "The film size for a width and/or height (0: not given), keeping the aspect ratio when one is given.",
+        py::arg("film_width"), py::arg("film_height"), py::arg("width"), py::arg("height"));
     m.def("gl_backend_available", []() {
         std::string reason;
         const bool ok = airlight::gl_backend_available(&reason);

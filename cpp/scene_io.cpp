@@ -373,6 +373,21 @@ Scene load_scene_file(const std::string& path) {
     return parse_scene(text);
 }
 
+Film resize_film(const Film& film, int width, int height) {
+    Film out = film;
+    if (width > 0 && height > 0) {
+        out.width = width;
+        out.height = height;
+    } else if (width > 0) {
+        out.width = width;
+        out.height = std::max(1, int(std::floor(double(width) * film.height / film.width + 0.5)));
+    } else if (height > 0) {
+        out.height = height;
+        out.width = std::max(1, int(std::floor(double(height) * film.width / film.height + 0.5)));
+    }
+    return out;
+}
+
 std::string scene_to_json(const Scene& scene, int indent) { return scene_to_json_value(scene).dump(indent); }
 
 }  // namespace airlight

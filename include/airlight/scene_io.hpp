@@ -31,6 +31,12 @@ Scene parse_scene(const std::string& json_text);
 // file is a value error on the field "path").
 Scene load_scene_file(const std::string& path);
 
+// The film size asked for by a width and/or a height, 0 meaning not given (the
+// demo's --width/--height, Python's render(width=, height=)): both given, that
+// size; one alone keeps the film's aspect ratio, the other side rounded to the
+// nearest integer (halves up) and at least 1; neither, the film unchanged.
+Film resize_film(const Film& film, int width, int height);
+
 // Writes a scene back as JSON with every default filled in and every RGB
 // value expanded to a triple; parse_scene(scene_to_json(s)) == s.
 std::string scene_to_json(const Scene& scene, int indent = 2);

@@ -87,7 +87,9 @@ class Renderer:
     def render(self, scene: SceneLike, *, width: int | None = None,
                height: int | None = None) -> np.ndarray:
         """Linear radiance of ``scene``: float32 array (height, width, 3), row 0
-        on top. ``width``/``height`` override the scene's film size."""
+        on top. ``width``/``height`` override the scene's film size; one of them alone
+        keeps the film's aspect ratio (``render(scene, width=160)`` of a 320x240 film
+        is 160x120: the other side rounded to the nearest integer, at least 1)."""
         return self._active().render(_with_film_size(scene, width, height))
 
     def close(self) -> None:

@@ -66,6 +66,18 @@ def test_demo_uses_the_scene_film_size_without_overrides(tmp_path: Path, scene_f
         assert np.asarray(png).any()
 
 
+@pytest.mark.parametrize(("args", "size"), [(["--width", "40"], (40, 30)), (["--height", "45"], (60, 45)),
+                                            (["--width", "40", "--height", "10"], (40, 10))])
+def test_demo_width_or_height_alone_keeps_the_aspect_ratio(tmp_path: Path, scene_file: Path, args: list[str],
+                                                           size: tuple[int, int]) -> None:
+    """The scene's film is 160x120: --width or --height alone keeps its aspect ratio (issue 17)."""
+    out = tmp_path / "x.png"
+    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", *args)
+    assert proc.returncode == 0, proc.stderr
+    with Image.open(out) as png:
+        assert png.size == size
+
+
 def test_demo_auto_backend_renders(tmp_path: Path, scene_file: Path) -> None:
     out = tmp_path / "x.png"
     proc = _demo("--scene", str(scene_file), "--out", str(out), "--width", "16", "--height", "12")
