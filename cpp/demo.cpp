@@ -295,6 +295,8 @@ int main(int argc, char** argv) {
     Scene scene;
     try {
         scene = load_scene_file(o.scene);
+    } catch (const SceneFileError& e) {
+        fail(e.what());  // "scene file not found: PATH"
     } catch (const SceneError& e) {
         fail(o.scene + ": " + e.what());
     }

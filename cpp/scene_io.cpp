@@ -350,26 +350,47 @@ json scene_to_json_value(const Scene& s) {
     return j;
 }
 
+namespace {
+
+// nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 2: syntax
+// error ..." without the library's prefix: "invalid JSON at line 1, column 2: syntax ...".
+std::string json_error_message(const nlohmann::json::exception& e) {
+    std::string m = e.what();
+    if (m.rfind("[json.exception.", 0) == 0) {
+        const auto end = m.find("] ");
+        if (end != std::string::npos) m.erase(0, end + 2);
+    }
+    if (m.rfind("parse error", 0) == 0) m.erase(0, std::strlen("parse error"));
+    if (m.rfind(": ", 0) == 0) m.erase(0, 2);
+    if (m.rfind(" at ", 0) == 0) return "invalid JSON" + m;
+    return "invalid JSON: " + m;
+}
+
+}  // namespace
+
 Scene parse_scene(const std::string& json_text) {
     json j;
     try {
         j = json::parse(json_text);
     } catch (const json::exception& e) {
-        fail(Kind::value, "", std::string("invalid JSON: ") + e.what());
+        fail(Kind::value, "", json_error_message(e));
     }
     return parse_scene_json(j);
 }
 
 Scene load_scene_file(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) fail(Kind::value, "path", "cannot open '" + path + "': " + std::strerror(errno));
+    if (!f) {
+        if (errno == ENOENT) throw SceneFileError("scene file not found: " + path);
+        throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(errno));
+    }
     std::string text;
     char buf[1 << 16];
     std::size_t n;
     while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
     int error = std::ferror(f) ? errno : 0;
     std::fclose(f);
-    if (error) fail(Kind::value, "path", "cannot read '" + path + "': " + std::strerror(error));
+    if (error) throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(error));
     return parse_scene(text);
 }
 

@@ -30,10 +30,12 @@ def _scene_source(scene: SceneLike) -> Any:
             return text
         try:
             return Path(text).read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ValueError(f"scene file not found: {text}") from None
         except OSError as exc:
-            raise ValueError(f"path: cannot read scene file {text!r}: {exc.strerror}") from None
+            raise ValueError(f"cannot read scene file {text}: {exc.strerror}") from None
         except (ValueError, UnicodeError) as exc:  # embedded NUL, undecodable bytes
-            raise ValueError(f"path: cannot read scene file {text!r}: {exc}") from None
+            raise ValueError(f"cannot read scene file {text!r}: {exc}") from None
     raise TypeError(f"scene: expected a dict, a path or JSON text, got {type(scene).__name__}")
 
 

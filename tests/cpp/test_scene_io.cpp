@@ -765,6 +765,19 @@ void test_text_errors() {
     check_text_error("{\"film\": ", Kind::value, "", "invalid JSON");
     check_text_error("", Kind::value, "", "invalid JSON");
     check_text_error("{\"film\": {\"width\": NaN}}", Kind::value, "", "invalid JSON");
+    // Without the parser library's prefix, one line that says where (issue 17).
+    for (const char* text : {"{\"film\": {\"width\": 10,\n\n \"height\": }", "{\"film\" 1}", "", "[1, 2"}) {
+        try {
+            airlight::parse_scene(text);
+            CHECK_MSG(false, std::string("no SceneError for: ") + text);
+        } catch (const SceneError& e) {
+            const std::string what = e.what();
+            CHECK_MSG(what.rfind("invalid JSON at line ", 0) == 0, what);
+            CHECK_MSG(what.find("json.exception") == std::string::npos && what.find('\n') == std::string::npos, what);
+        }
+    }
+    check_text_error("{\"film\": {\"width\": 10,\n\n \"height\": }", Kind::value, "",
+                     "invalid JSON at line 3, column 12: syntax error while parsing value");
     check_text_error("[1, 2, 3]", Kind::type, "", "scene must be a JSON object");
     check_text_error("\"scene\"", Kind::type, "", "scene must be a JSON object");
     check_text_error("{}", Kind::value, "film", "missing required key");
@@ -1130,17 +1143,20 @@ void test_round_trip() {
 }
 
 void test_files() {
+    // A missing or unreadable file says so, with the path (issue 17: no bare "path:" label).
     try {
         airlight::load_scene_file("/nonexistent/scene.json");
         CHECK(false);
-    } catch (const SceneError& e) {
-        CHECK(e.kind() == Kind::value && e.field() == "path");
+    } catch (const airlight::SceneFileError& e) {
+        CHECK(e.kind() == Kind::value && e.field().empty());
+        CHECK_MSG(std::string(e.what()) == "scene file not found: /nonexistent/scene.json", e.what());
     }
     try {
         airlight::load_scene_file("/tmp");  // a directory
         CHECK(false);
-    } catch (const SceneError& e) {
-        CHECK(e.kind() == Kind::value && e.field() == "path");
+    } catch (const airlight::SceneFileError& e) {
+        CHECK(e.kind() == Kind::value && e.field().empty());
+        CHECK_MSG(std::string(e.what()) == "cannot read scene file /tmp: Is a directory", e.what());
     }
     std::string path = "/tmp/airlight_test_scene_" + std::to_string(std::random_device{}()) + ".json";
     if (std::FILE* f = std::fopen(path.c_str(), "wb")) {

@@ -104,15 +104,20 @@ def test_demo_bad_scene_exits_nonzero_with_one_line_naming_the_field(
 
 
 def test_demo_invalid_json_exits_nonzero_with_one_line(tmp_path: Path) -> None:
+    """The file, then where the JSON breaks, without the parser library's prefix (issue 17)."""
     path = tmp_path / "broken.json"
     path.write_text('{"film": {"width": 10,\n\n "height": }')
-    _assert_one_line_error(_demo("--scene", str(path), "--out", str(tmp_path / "x.png"), "--backend", "cpu"),
-                           "JSON")
+    proc = _demo("--scene", str(path), "--out", str(tmp_path / "x.png"), "--backend", "cpu")
+    line = _assert_one_line_error(proc, "JSON")
+    assert line.startswith(f"airlight-demo: {path}: invalid JSON at line 3, column 12: syntax error"), line
+    assert "json.exception" not in line, line
 
 
 def test_demo_missing_scene_file_exits_nonzero_with_one_line(tmp_path: Path) -> None:
     missing = tmp_path / "missing.json"
-    _assert_one_line_error(_demo("--scene", str(missing), "--out", str(tmp_path / "x.png")), str(missing))
+    proc = _demo("--scene", str(missing), "--out", str(tmp_path / "x.png"))
+    line = _assert_one_line_error(proc, str(missing))
+    assert line == f"airlight-demo: scene file not found: {missing}", line
 
 
 @pytest.mark.parametrize("args", [["--bogus", "1"], ["--bogus"], ["-x"], ["extra"]])
