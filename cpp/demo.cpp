@@ -306,11 +306,19 @@ int main(int argc, char** argv) {
     if (o.backend == "gl") {
         backend = Backend::gl;
     } else if (o.backend == "auto") {
-        std::string reason;
-        if (gl_backend_available(&reason))
-            backend = Backend::gl;
+        // The CPU also where the only GL is a software rasteriser (choose_auto_backend).
+        const AutoBackend chosen = choose_auto_backend();
+        backend = chosen.backend;
+        if (!chosen.gl_available)
+            std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n",
+                         chosen.gl_unavailable_reason.c_str());
+        else if (chosen.gl_software)
+            std::printf(
+                "airlight-demo: backend auto: cpu (the GL renderer, %s, is a software rasteriser; "
+                "--backend gl uses it)\n",
+                chosen.gl_renderer.c_str());
         else
-            std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
+            std::printf("airlight-demo: backend auto: gl (%s)\n", chosen.gl_renderer.c_str());
     }
     try {
         if (o.sequence == "approaching-car") return run_sequence(scene, o, backend);

@@ -153,6 +153,18 @@ PYBIND11_MODULE(_core, m) {
         },
         "The film size for a width and/or height (0: not given), keeping the aspect ratio when one is given.",
         py::arg("film_width"), py::arg("film_height"), py::arg("width"), py::arg("height"));
+    m.def("backend_info", []() {
+        const airlight::AutoBackend a = airlight::choose_auto_backend();
+        py::dict d;
+        d["auto"] = airlight::backend_name(a.backend);
+        d["gl_available"] = a.gl_available;
+        d["gl_renderer"] = a.gl_available ? py::object(py::str(a.gl_renderer)) : py::object(py::none());
+        d["gl_software"] = a.gl_software;
+        d["gl_unavailable_reason"] =
+            a.gl_available ? py::object(py::none()) : py::object(py::str(a.gl_unavailable_reason));
+        return d;
+    });
+    m.def("is_software_gl_renderer", &airlight::is_software_gl_renderer, py::arg("gl_renderer"));
     m.def("gl_backend_available", []() {
         std::string reason;
         const bool ok = airlight::gl_backend_available(&reason);

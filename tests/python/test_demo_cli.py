@@ -79,10 +79,20 @@ def test_demo_width_or_height_alone_keeps_the_aspect_ratio(tmp_path: Path, scene
 
 
 def test_demo_auto_backend_renders(tmp_path: Path, scene_file: Path) -> None:
+    """--backend auto picks what airlight.backend_info() says and names the GL renderer it found
+    (issue 17): the CPU where it is a software rasteriser (llvmpipe)."""
+    import airlight
+
     out = tmp_path / "x.png"
     proc = _demo("--scene", str(scene_file), "--out", str(out), "--width", "16", "--height", "12")
     assert proc.returncode == 0, proc.stderr
     assert out.is_file()
+    info = airlight.backend_info()
+    assert f"({info['auto']} backend" in proc.stdout, proc.stdout
+    if info["gl_available"]:
+        assert f"backend auto: {info['auto']} " in proc.stdout, proc.stdout
+        assert info["gl_renderer"] in proc.stdout, proc.stdout
+        assert proc.stderr == ""
 
 
 @pytest.mark.parametrize(("edit", "field"), [
