@@ -16,18 +16,23 @@
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
+#include "window_controls.hpp"
 
 #ifdef AIRLIGHT_HAVE_GLFW
 namespace airlight {
-int run_window(Scene scene, Backend backend, DisplaySettings display);  // demo_window.cpp
-}
+// demo_window.cpp; `out` (may be empty): where the last frame shown is written on closing.
+int run_window(Scene scene, Backend backend, DisplaySettings display, const std::string& out);
+}  // namespace airlight
 #endif
 
 namespace {
 
 const char* kUsage =
     "usage: airlight-demo --scene S.json --out F.png|F.pfm [--backend auto|gl|cpu]\n"
-    "                     [--width W --height H] [--window]\n"
+    "                     [--width W] [--height H] (one alone: the scene's aspect ratio)\n"
+    "  an interactive window (GLFW and a display; --out optional: the last frame shown\n"
+    "  is written there on closing):\n"
+    "                     --scene S.json --window [--out F.png|F.pfm]\n"
     "  display stage (PNG; overrides the scene's \"display\" object):\n"
     "                     [--exposure E|auto] [--tonemap linear|loglog|reinhard|filmic]\n"
     "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
@@ -84,6 +89,7 @@ Options parse_args(int argc, char** argv) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
             std::fputs(kUsage, stdout);
+            std::printf("  the window's keys (also in its title): %s\n", airlight::kWindowKeysHelp);
             std::exit(0);
         }
         if (arg == "--window") {
@@ -148,6 +154,7 @@ Options parse_args(int argc, char** argv) {
         fail("--backend must be auto, gl or cpu, got '" + o.backend + "'");
     }
     if (o.sequence == "approaching-car" && o.to > o.from) fail("--to must not be greater than --from");
+    if (o.window && !o.sequence.empty()) fail("--window and --sequence cannot be combined");
     return o;
 }
 
@@ -325,7 +332,7 @@ int main(int argc, char** argv) {
         if (o.sequence == "rain-ends") return run_rain_ends(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
-            return run_window(scene, backend, display_settings(scene, o));
+            return run_window(scene, backend, display_settings(scene, o), o.out);
 #else
             fail("--window needs a build with GLFW");
 #endif

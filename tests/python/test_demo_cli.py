@@ -187,6 +187,38 @@ def test_demo_help_exits_zero_with_usage() -> None:
         assert proc.stderr == ""
 
 
+def test_demo_help_documents_the_window_and_its_keys() -> None:
+    """--help shows --window without a required --out and every key of the window (issue 17:
+    Esc was not documented)."""
+    proc = _demo("--help")
+    assert proc.returncode == 0
+    assert "--window [--out" in proc.stdout, proc.stdout
+    for key in ("W/S", "A/D", "Q/E", "arrow keys", "+/-", "Esc"):
+        assert key in proc.stdout, (key, proc.stdout)
+
+
+def test_demo_window_needs_no_out(tmp_path: Path, scene_file: Path) -> None:
+    """--window without --out is accepted (the last frame is saved only when --out is given):
+    here, without a display, it fails only for want of a window, on one line."""
+    if not DEMO.exists():
+        pytest.skip(f"{DEMO} is not installed")
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.run([str(DEMO), "--scene", str(scene_file), "--window", "--backend", "cpu"],
+                          capture_output=True, text=True, timeout=60, env=env)
+    line = _assert_one_line_error(proc, "window")
+    assert "--out" not in line, line
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["--window", "--sequence", "approaching-car", "--out", "{tmp}/frames"], "--window"),
+    (["--window", "--out", "{tmp}/x.jpg"], "--out"),
+])
+def test_demo_bad_window_options_exit_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
+                                                            args: list[str], needle: str) -> None:
+    _assert_one_line_error(_demo("--scene", str(scene_file), *(a.format(tmp=tmp_path) for a in args)), needle)
+    assert not any(tmp_path.glob("frames*")) and not (tmp_path / "x.jpg").exists()
+
+
 def _demo_without_gl(*args: str) -> subprocess.CompletedProcess:
     if not DEMO.exists():
         pytest.skip(f"{DEMO} is not installed")
