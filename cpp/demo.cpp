@@ -8,6 +8,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
+#include <glm/vec3.hpp>
 #include <string>
 #include <vector>
 
@@ -15,24 +16,30 @@
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
+#include "window_controls.hpp"
 
 #ifdef AIRLIGHT_HAVE_GLFW
 namespace airlight {
-int run_window(Scene scene, Backend backend, DisplaySettings display);  // demo_window.cpp
-}
+// demo_window.cpp; `out` (may be empty): where the last frame shown is written on closing.
+int run_window(Scene scene, Backend backend, DisplaySettings display, const std::string& out);
+}  // namespace airlight
 #endif
 
 namespace {
 
 const char* kUsage =
     "usage: airlight-demo --scene S.json --out F.png|F.pfm [--backend auto|gl|cpu]\n"
-    "                     [--width W --height H] [--window]\n"
+    "                     [--width W] [--height H] (one alone: the scene's aspect ratio)\n"
+    "  an interactive window (GLFW and a display; --out optional: the last frame shown\n"
+    "  is written there on closing):\n"
+    "                     --scene S.json --window [--out F.png|F.pfm]\n"
     "  display stage (PNG; overrides the scene's \"display\" object):\n"
     "                     [--exposure E|auto] [--tonemap linear|loglog|reinhard|filmic]\n"
     "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
     "                     [--dither | --no-dither]\n"
-    "  the headlight experiment (a car approaching from --from to --to metres,\n"
-    "  the camera tracking it; frames DIR/frame_NN_DDDDm.png):\n"
+    "  the headlight experiment (the scene's lights, a car, approaching from --from to\n"
+    "  --to metres, default 2000 and 20, the camera tracking it; one frame: at --from;\n"
+    "  frames DIR/frame_NN_DDDDm.png):\n"
     "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n"
     "  the end of a rain (a rainbow appearing and fading; needs atmosphere.rain and a sun):\n"
     "                     --sequence rain-ends --out DIR [--frames N]\n";
@@ -82,6 +89,7 @@ Options parse_args(int argc, char** argv) {
         const std::string arg = argv[i];
         if (arg == "-h" || arg == "--help") {
             std::fputs(kUsage, stdout);
+            std::printf("  the window's keys (also in its title): %s\n", airlight::kWindowKeysHelp);
             std::exit(0);
         }
         if (arg == "--window") {
@@ -132,7 +140,7 @@ Options parse_args(int argc, char** argv) {
             if (o.sequence != "approaching-car" && o.sequence != "rain-ends")
                 fail("--sequence must be approaching-car or rain-ends, got '" + o.sequence + "'");
         } else if (arg == "--frames")
-            o.frames = parse_int(arg, value, 2, 1000);
+            o.frames = parse_int(arg, value, 1, 1000);
         else if (arg == "--from")
             o.from = parse_number(arg, value, 1.0, 1e5, "a distance in [1, 1e5] m");
         else if (arg == "--to")
@@ -145,7 +153,8 @@ Options parse_args(int argc, char** argv) {
     if (o.backend != "auto" && o.backend != "gl" && o.backend != "cpu") {
         fail("--backend must be auto, gl or cpu, got '" + o.backend + "'");
     }
-    if (o.sequence == "approaching-car" && !(o.to < o.from)) fail("--to must be less than --from");
+    if (o.sequence == "approaching-car" && o.to > o.from) fail("--to must not be greater than --from");
+    if (o.window && !o.sequence.empty()) fail("--window and --sequence cannot be combined");
     return o;
 }
 
@@ -192,38 +201,40 @@ void print_report(const std::string& path, const airlight::Image& image, airligh
     std::printf(")\n");
 }
 
-// The headlight experiment of the source paper (effects/display/physics.md): a car's
-// two headlights (spots 1.5 m apart, 0.65 m high, aimed at the camera)
-// approach along the road from `from` to `to` metres (distances spaced
-// evenly in log), the camera (1.2 m high) tracking the midpoint between them.
-// Everything else (film, field of view, medium, road, display with the
-// pupil) comes from the scene file: scenes/approaching_car.json sets a 1 mm
-// pupil and 0.34 mrad pixels (half the resolution angle 1.22 lambda / D), so
+// The headlight experiment of the source paper (effects/display/physics.md): a car
+// approaches along the road (-z) from `from` to `to` metres (distances spaced
+// evenly in log; one frame: at `from`), the camera tracking it. The car is the
+// scene's lights: scenes/approaching_car.json has its two headlights (spots
+// 1.5 m apart, 0.65 m high, aimed at the camera) 200 m ahead, and each frame
+// moves every light along z so that their midpoint is `d` metres ahead of the
+// camera, which looks at that midpoint. Everything else (film, field of view,
+// medium, display with the pupil) comes from the scene file: the preset sets a
+// 1 mm pupil and 0.68 mrad pixels (the resolution angle 1.22 lambda / D), so
 // the lamps, one spot at 2 km, become an ellipse and then two.
 int run_sequence(airlight::Scene scene, const Options& o, airlight::Backend backend) {
     using namespace airlight;
+    const std::size_t lamps = scene.point_lights.size() + scene.spot_lights.size();
+    if (lamps == 0) fail("--sequence approaching-car: the scene needs the car's lights (lights[])");
+    glm::dvec3 middle(0.0);
+    for (const auto& l : scene.point_lights) middle += glm::dvec3(l.position);
+    for (const auto& l : scene.spot_lights) middle += glm::dvec3(l.position);
+    middle /= double(lamps);
     const DisplaySettings settings = display_settings(scene, o);
     std::error_code error;
     std::filesystem::create_directories(o.out, error);
     if (error) fail("--out: cannot create directory '" + o.out + "': " + error.message());
     Renderer renderer(backend);
-    const glm::vec3 camera(0.0f, 1.2f, 0.0f);
     for (int k = 0; k < o.frames; ++k) {
-        const double d = o.from * std::pow(o.to / o.from, double(k) / double(o.frames - 1));
+        const double t = o.frames > 1 ? double(k) / double(o.frames - 1) : 0.0;
+        const double d = o.from * std::pow(o.to / o.from, t);
+        // Moves the car so that its middle is d metres ahead (-z) of the camera.
+        const double shift = double(scene.camera.position.z) - d - middle.z;
+        auto moved = [&](glm::vec3 p) { return glm::vec3(p.x, p.y, float(double(p.z) + shift)); };
         Scene frame = scene;
-        frame.camera.position = camera;
-        frame.camera.look_at = glm::vec3(0.0f, 0.65f, -float(d));
+        for (auto& l : frame.point_lights) l.position = moved(l.position);
+        for (auto& l : frame.spot_lights) l.position = moved(l.position);
+        frame.camera.look_at = glm::vec3(middle.x, middle.y, double(scene.camera.position.z) - d);
         frame.camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
-        for (float side : {-0.75f, 0.75f}) {
-            SpotLight lamp;
-            lamp.position = glm::vec3(side, 0.65f, -float(d));
-            lamp.direction = glm::vec3(0.0f, -0.02f, 1.0f);
-            lamp.intensity = glm::vec3(2000.0f, 1900.0f, 1700.0f);
-            lamp.cone_angle_degrees = 25.0f;
-            lamp.edge = 0.3f;
-            lamp.radius = 0.09f;
-            frame.spot_lights.push_back(lamp);
-        }
         const auto start = std::chrono::steady_clock::now();
         const Image image = renderer.render(frame);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
@@ -261,7 +272,7 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
     }
     const float density0 = scene.atmosphere.rain.density_scale;
     for (int k = 0; k < o.frames; ++k) {
-        const double t = double(k) / double(o.frames - 1);
+        const double t = o.frames > 1 ? double(k) / double(o.frames - 1) : 0.0;  // one frame: the first
         const double s = std::min(1.0, t / 0.4);
         Scene frame = scene;
         frame.sun.irradiance = scene.sun.irradiance * float(s * s * (3.0 - 2.0 * s));
@@ -291,28 +302,37 @@ int main(int argc, char** argv) {
     Scene scene;
     try {
         scene = load_scene_file(o.scene);
+    } catch (const SceneFileError& e) {
+        fail(e.what());  // "scene file not found: PATH"
     } catch (const SceneError& e) {
         fail(o.scene + ": " + e.what());
     }
-    if (o.width > 0) scene.film.width = o.width;
-    if (o.height > 0) scene.film.height = o.height;
+    scene.film = resize_film(scene.film, o.width, o.height);  // one of them: the scene's aspect ratio
 
     Backend backend = Backend::cpu;
     if (o.backend == "gl") {
         backend = Backend::gl;
     } else if (o.backend == "auto") {
-        std::string reason;
-        if (gl_backend_available(&reason))
-            backend = Backend::gl;
+        // The CPU also where the only GL is a software rasteriser (choose_auto_backend).
+        const AutoBackend chosen = choose_auto_backend();
+        backend = chosen.backend;
+        if (!chosen.gl_available)
+            std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n",
+                         chosen.gl_unavailable_reason.c_str());
+        else if (chosen.gl_software)
+            std::printf(
+                "airlight-demo: backend auto: cpu (the GL renderer, %s, is a software rasteriser; "
+                "--backend gl uses it)\n",
+                chosen.gl_renderer.c_str());
         else
-            std::fprintf(stderr, "airlight-demo: GL unavailable (%s); using the cpu backend\n", reason.c_str());
+            std::printf("airlight-demo: backend auto: gl (%s)\n", chosen.gl_renderer.c_str());
     }
     try {
         if (o.sequence == "approaching-car") return run_sequence(scene, o, backend);
         if (o.sequence == "rain-ends") return run_rain_ends(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
-            return run_window(scene, backend, display_settings(scene, o));
+            return run_window(scene, backend, display_settings(scene, o), o.out);
 #else
             fail("--window needs a build with GLFW");
 #endif

@@ -1,10 +1,15 @@
 // airlight-demo --window: an interactive view (needs GLFW and a display).
-// W/A/S/D move, Q/E down/up, arrow keys turn, +/- exposure, Esc quits. Each
-// frame is rendered by a Renderer (GL or CPU backend), passed through the
-// display stage (the scene's display settings: exposure, glare, tone curve)
-// on the same backend, and shown as a texture.
+// W/S forward/back, A/D left/right, Q/E down/up, arrow keys turn, +/-
+// exposure, Esc quits (cpp/window_controls.hpp; the window's title lists them).
+// Keys come from GLFW's key callback with their times, so a tap shorter than
+// a frame still counts. Each frame is rendered by a Renderer (GL or CPU
+// backend), passed through the display stage (the scene's display settings:
+// exposure, glare, tone curve) on the same backend, and shown as a texture.
+// With an output path, the last frame shown is written there on closing.
 #include "airlight/display.hpp"
+#include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
+#include "window_controls.hpp"
 
 #define GLFW_INCLUDE_NONE
 #include <GLFW/glfw3.h>
@@ -50,61 +55,102 @@ GLuint build_blit_program() {
     return program;
 }
 
+// The action of a GLFW key, or WindowAction::count for none.
+WindowAction action_of_key(int key) {
+    switch (key) {
+        case GLFW_KEY_W:
+            return WindowAction::forward;
+        case GLFW_KEY_S:
+            return WindowAction::back;
+        case GLFW_KEY_A:
+            return WindowAction::left;
+        case GLFW_KEY_D:
+            return WindowAction::right;
+        case GLFW_KEY_Q:
+            return WindowAction::down;
+        case GLFW_KEY_E:
+            return WindowAction::up;
+        case GLFW_KEY_LEFT:
+            return WindowAction::turn_left;
+        case GLFW_KEY_RIGHT:
+            return WindowAction::turn_right;
+        case GLFW_KEY_UP:
+            return WindowAction::turn_up;
+        case GLFW_KEY_DOWN:
+            return WindowAction::turn_down;
+        case GLFW_KEY_EQUAL:
+        case GLFW_KEY_KP_ADD:
+            return WindowAction::brighter;
+        case GLFW_KEY_MINUS:
+        case GLFW_KEY_KP_SUBTRACT:
+            return WindowAction::darker;
+        case GLFW_KEY_ESCAPE:
+            return WindowAction::quit;
+        default:
+            return WindowAction::count;
+    }
+}
+
+void on_key(GLFWwindow* window, int key, int /*scancode*/, int action, int /*mods*/) {
+    auto* keys = static_cast<WindowKeys*>(glfwGetWindowUserPointer(window));
+    const WindowAction a = action_of_key(key);
+    if (keys == nullptr || a == WindowAction::count) return;
+    if (action == GLFW_PRESS) keys->press(a, glfwGetTime());
+    if (action == GLFW_RELEASE) keys->release(a, glfwGetTime());
+}
+
 }  // namespace
 
-int run_window(Scene scene, Backend backend, DisplaySettings display) {
+int run_window(Scene scene, Backend backend, DisplaySettings display, const std::string& out) {
     if (!glfwInit()) throw std::runtime_error("cannot open a window (no display?)");
     glfwWindowHint(GLFW_CONTEXT_VERSION_MAJOR, 4);
     glfwWindowHint(GLFW_CONTEXT_VERSION_MINOR, 5);
     glfwWindowHint(GLFW_OPENGL_PROFILE, GLFW_OPENGL_CORE_PROFILE);
     // EGL, like the GL backend: GLX and EGL contexts cannot take turns on one thread.
     glfwWindowHint(GLFW_CONTEXT_CREATION_API, GLFW_EGL_CONTEXT_API);
-    GLFWwindow* window = glfwCreateWindow(scene.film.width, scene.film.height, "airlight", nullptr, nullptr);
+    GLFWwindow* window =
+        glfwCreateWindow(scene.film.width, scene.film.height, window_title(display.exposure).c_str(), nullptr, nullptr);
     if (window == nullptr) {
         glfwTerminate();
         throw std::runtime_error("cannot create a 4.5 core window");
     }
+    std::printf("airlight-demo: window keys: %s\n", kWindowKeysHelp);
+    std::fflush(stdout);
     Renderer renderer(backend);
     glfwMakeContextCurrent(window);
     GLuint program = build_blit_program();
     GLuint vao = 0, texture = 0;
     glCreateVertexArrays(1, &vao);
 
-    glm::vec3 forward = glm::normalize(scene.camera.look_at - scene.camera.position);
-    float yaw = std::atan2(forward.x, -forward.z);
-    float pitch = std::asin(glm::clamp(forward.y, -1.0f, 1.0f));
-    double last = glfwGetTime();
+    WindowKeys keys(glfwGetTime());
+    glfwSetWindowUserPointer(window, &keys);
+    glfwSetKeyCallback(window, on_key);
+    const glm::vec3 forward = glm::normalize(scene.camera.look_at - scene.camera.position);
+    WindowView view;
+    view.position = scene.camera.position;
+    view.yaw = std::atan2(forward.x, -forward.z);
+    view.pitch = std::asin(glm::clamp(forward.y, -1.0f, 1.0f));
+    view.exposure = display.exposure;
     int tex_w = 0, tex_h = 0;
-    float shown_exposure = display.exposure;  // the exposure of the last frame shown
+    Image image;
+    DisplayImage shown;
     while (!glfwWindowShouldClose(window)) {
         glfwPollEvents();
-        const double now = glfwGetTime();
-        const float dt = float(now - last);
-        last = now;
-        auto down = [&](int key) { return glfwGetKey(window, key) == GLFW_PRESS; };
-        if (down(GLFW_KEY_ESCAPE)) break;
-        yaw += dt * ((down(GLFW_KEY_RIGHT) ? 1.0f : 0.0f) - (down(GLFW_KEY_LEFT) ? 1.0f : 0.0f));
-        pitch = glm::clamp(pitch + dt * ((down(GLFW_KEY_UP) ? 1.0f : 0.0f) - (down(GLFW_KEY_DOWN) ? 1.0f : 0.0f)),
-                           -1.5f, 1.5f);
-        forward = glm::vec3(std::sin(yaw) * std::cos(pitch), std::sin(pitch), -std::cos(yaw) * std::cos(pitch));
-        const glm::vec3 right = glm::normalize(glm::cross(forward, glm::vec3(0, 1, 0)));
-        const float speed = 10.0f * dt;
-        glm::vec3& pos = scene.camera.position;
-        pos += forward * speed * ((down(GLFW_KEY_W) ? 1.0f : 0.0f) - (down(GLFW_KEY_S) ? 1.0f : 0.0f));
-        pos += right * speed * ((down(GLFW_KEY_D) ? 1.0f : 0.0f) - (down(GLFW_KEY_A) ? 1.0f : 0.0f));
-        pos.y += speed * ((down(GLFW_KEY_E) ? 1.0f : 0.0f) - (down(GLFW_KEY_Q) ? 1.0f : 0.0f));
-        if (down(GLFW_KEY_EQUAL) || down(GLFW_KEY_MINUS)) {
-            // From automatic exposure, +/- start at the exposure it chose.
+        const HeldKeys held = keys.take(glfwGetTime());
+        if (held.quit) break;
+        if (apply_window_keys(held, view)) {
             display.exposure_mode = ExposureMode::manual;
-            display.exposure = shown_exposure * (down(GLFW_KEY_EQUAL) ? 1.0f + dt : 1.0f / (1.0f + dt));
+            display.exposure = view.exposure;
         }
-        scene.camera.look_at = pos + forward;
+        scene.camera.position = view.position;
+        scene.camera.look_at = view.position + view.forward();
         scene.camera.up = glm::vec3(0, 1, 0);
 
-        const Image image = renderer.render(scene);
-        const DisplayImage shown = renderer.display(image, display, scene.camera.fov_y_degrees);
-        shown_exposure = shown.report.exposure;
-        glfwMakeContextCurrent(window);  // the GL backend switches to its own context
+        image = renderer.render(scene);
+        shown = renderer.display(image, display, scene.camera.fov_y_degrees);
+        view.exposure = shown.report.exposure;  // from automatic exposure, +/- start at the one it chose
+        glfwMakeContextCurrent(window);         // the GL backend switches to its own context
+        glfwSetWindowTitle(window, window_title(shown.report.exposure).c_str());
         if (shown.width != tex_w || shown.height != tex_h) {
             if (texture != 0) glDeleteTextures(1, &texture);
             glCreateTextures(GL_TEXTURE_2D, 1, &texture);
@@ -126,6 +172,15 @@ int run_window(Scene scene, Backend backend, DisplaySettings display) {
     }
     glfwDestroyWindow(window);
     glfwTerminate();
+    if (!out.empty() && !image.rgb.empty()) {
+        // The last frame shown: the PNG as displayed, the PFM as its radiance.
+        const bool pfm = out.size() >= 4 && out.compare(out.size() - 4, 4, ".pfm") == 0;
+        if (pfm)
+            write_pfm(out, image);
+        else
+            write_png(out, shown.width, shown.height, shown.srgb8);
+        std::printf("airlight-demo: %s %dx%d (the last frame shown)\n", out.c_str(), image.width, image.height);
+    }
     return 0;
 }
 

@@ -314,10 +314,14 @@ struct GlBackend::State {
     }
 };
 
-bool gl_backend_available(std::string* reason) {
+bool gl_backend_available(std::string* reason, std::string* gl_renderer) {
     EglContext ctx;
     std::string why;
     const bool ok = create_context(ctx, why);
+    if (ok && gl_renderer != nullptr) {
+        const GLubyte* name = glGetString(GL_RENDERER);
+        *gl_renderer = name != nullptr ? reinterpret_cast<const char*>(name) : "";
+    }
     if (ok) destroy_context(ctx);
     if (!ok && reason != nullptr) *reason = why;
     return ok;

@@ -6,7 +6,7 @@ namespace airlight {
 
 struct GlBackend::State {};
 
-bool gl_backend_available(std::string* reason) {
+bool gl_backend_available(std::string* reason, std::string*) {
     if (reason != nullptr) *reason = "airlight was built without EGL/OpenGL";
     return false;
 }

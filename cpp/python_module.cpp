@@ -145,6 +145,26 @@ PYBIND11_MODULE(_core, m) {
         "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");
     m.def("load_scene_file",
           [](const std::string& path) { return airlight::scene_to_json(airlight::load_scene_file(path), -1); });
+    m.def(
+        "resize_film",
+        [](int film_width, int film_height, int width, int height) {
+            const airlight::Film f = airlight::resize_film(airlight::Film{film_width, film_height}, width, height);
+            return std::make_pair(f.width, f.height);
+        },
+        "The film size for a width and/or height (0: not given), keeping the aspect ratio when one is given.",
+        py::arg("film_width"), py::arg("film_height"), py::arg("width"), py::arg("height"));
+    m.def("backend_info", []() {
+        const airlight::AutoBackend a = airlight::choose_auto_backend();
+        py::dict d;
+        d["auto"] = airlight::backend_name(a.backend);
+        d["gl_available"] = a.gl_available;
+        d["gl_renderer"] = a.gl_available ? py::object(py::str(a.gl_renderer)) : py::object(py::none());
+        d["gl_software"] = a.gl_software;
+        d["gl_unavailable_reason"] =
+            a.gl_available ? py::object(py::none()) : py::object(py::str(a.gl_unavailable_reason));
+        return d;
+    });
+    m.def("is_software_gl_renderer", &airlight::is_software_gl_renderer, py::arg("gl_renderer"));
     m.def("gl_backend_available", []() {
         std::string reason;
         const bool ok = airlight::gl_backend_available(&reason);

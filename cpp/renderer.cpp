@@ -1,5 +1,7 @@
 #include "airlight/renderer.hpp"
 
+#include <algorithm>
+#include <cctype>
 #include <mutex>
 #include <vector>
 
@@ -9,6 +11,23 @@
 namespace airlight {
 
 const char* backend_name(Backend backend) { return backend == Backend::gl ? "gl" : "cpu"; }
+
+bool is_software_gl_renderer(const std::string& gl_renderer) {
+    std::string name = gl_renderer;
+    std::transform(name.begin(), name.end(), name.begin(), [](unsigned char c) { return char(std::tolower(c)); });
+    for (const char* software : {"llvmpipe", "softpipe", "swrast"})
+        if (name.find(software) != std::string::npos) return true;
+    return false;
+}
+
+AutoBackend choose_auto_backend() {
+    AutoBackend a;
+    a.gl_available = gl_backend_available(&a.gl_unavailable_reason, &a.gl_renderer);
+    if (a.gl_available) a.gl_unavailable_reason.clear();
+    a.gl_software = a.gl_available && is_software_gl_renderer(a.gl_renderer);
+    a.backend = a.gl_available && !a.gl_software ? Backend::gl : Backend::cpu;
+    return a;
+}
 
 struct Renderer::Impl {
     Backend backend;

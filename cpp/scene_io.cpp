@@ -128,9 +128,16 @@ Phase parse_phase(const SceneObject& o) {
 }
 
 Medium parse_medium(const SceneObject& o) {
-    o.check_keys({"sigma_t", "albedo", "phase"});
+    o.check_keys({"sigma_t", "visibility", "albedo", "phase"});
     Medium m;
-    m.sigma_t = read_rgb(o.req("sigma_t"), max_extinction);
+    // Exactly one of sigma_t and the visibility (Koschmieder, as the aerosol's).
+    const Either given = read_either(o, "sigma_t", "sigma_t (1/m)", "visibility", "visibility (m)");
+    if (given.first) {
+        m.sigma_t = read_rgb(given.value, max_extinction);
+    } else {
+        m.visibility = read_visibility(given.value);
+        m.sigma_t = Rgb(visibility_extinction(m.visibility));
+    }
     if (auto v = o.opt("albedo")) m.albedo = read_rgb(*v, 1.0);
     if (auto v = o.opt("phase")) m.phase = parse_phase(SceneObject(*v));
     return m;
@@ -293,9 +300,14 @@ json scene_to_json_value(const Scene& s) {
                    {"up", json_vec3(s.camera.up)},
                    {"fov_y", json_number(s.camera.fov_y_degrees)}};
     if (s.has_medium) {
-        j["medium"] = {{"sigma_t", json_vec3(s.medium.sigma_t)},
-                       {"albedo", json_vec3(s.medium.albedo)},
-                       {"phase", phase_to_json(s.medium.phase)}};
+        // By its visibility where the scene gave one and sigma_t is still its value.
+        const bool by_visibility =
+            s.medium.visibility > 0.0f && s.medium.sigma_t == Rgb(visibility_extinction(s.medium.visibility));
+        j["medium"] = {{"albedo", json_vec3(s.medium.albedo)}, {"phase", phase_to_json(s.medium.phase)}};
+        if (by_visibility)
+            j["medium"]["visibility"] = json_number(s.medium.visibility);
+        else
+            j["medium"]["sigma_t"] = json_vec3(s.medium.sigma_t);
     } else {
         j["medium"] = nullptr;
     }
@@ -348,27 +360,63 @@ json scene_to_json_value(const Scene& s) {
     return j;
 }
 
+namespace {
+
+// nlohmann's "[json.exception.parse_error.101] parse error at line 1, column 2: syntax
+// error ..." without the library's prefix: "invalid JSON at line 1, column 2: syntax ...".
+std::string json_error_message(const nlohmann::json::exception& e) {
+    std::string m = e.what();
+    if (m.rfind("[json.exception.", 0) == 0) {
+        const auto end = m.find("] ");
+        if (end != std::string::npos) m.erase(0, end + 2);
+    }
+    if (m.rfind("parse error", 0) == 0) m.erase(0, std::strlen("parse error"));
+    if (m.rfind(": ", 0) == 0) m.erase(0, 2);
+    if (m.rfind(" at ", 0) == 0) return "invalid JSON" + m;
+    return "invalid JSON: " + m;
+}
+
+}  // namespace
+
 Scene parse_scene(const std::string& json_text) {
     json j;
     try {
         j = json::parse(json_text);
     } catch (const json::exception& e) {
-        fail(Kind::value, "", std::string("invalid JSON: ") + e.what());
+        fail(Kind::value, "", json_error_message(e));
     }
     return parse_scene_json(j);
 }
 
 Scene load_scene_file(const std::string& path) {
     std::FILE* f = std::fopen(path.c_str(), "rb");
-    if (!f) fail(Kind::value, "path", "cannot open '" + path + "': " + std::strerror(errno));
+    if (!f) {
+        if (errno == ENOENT) throw SceneFileError("scene file not found: " + path);
+        throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(errno));
+    }
     std::string text;
     char buf[1 << 16];
     std::size_t n;
     while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
     int error = std::ferror(f) ? errno : 0;
     std::fclose(f);
-    if (error) fail(Kind::value, "path", "cannot read '" + path + "': " + std::strerror(error));
+    if (error) throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(error));
     return parse_scene(text);
+}
+
+Film resize_film(const Film& film, int width, int height) {
+    Film out = film;
+    if (width > 0 && height > 0) {
+        out.width = width;
+        out.height = height;
+    } else if (width > 0) {
+        out.width = width;
+        out.height = std::max(1, int(std::floor(double(width) * film.height / film.width + 0.5)));
+    } else if (height > 0) {
+        out.height = height;
+        out.width = std::max(1, int(std::floor(double(height) * film.width / film.height + 0.5)));
+    }
+    return out;
 }
 
 std::string scene_to_json(const Scene& scene, int indent) { return scene_to_json_value(scene).dump(indent); }

@@ -206,6 +206,26 @@ float read_asymmetry(const Value& v) {
     return f;
 }
 
+float read_visibility(const Value& v) {
+    const float visibility = read_positive(v, 1e9, true);
+    // Koschmieder's sigma_t stays within max_extinction.
+    if (double(visibility) < KOSCHMIEDER / max_extinction)
+        fail(Kind::value, v.field,
+             "must be >= " + format_number(KOSCHMIEDER / max_extinction) + " (sigma_t <= 1000 /m)");
+    return visibility;
+}
+
+float visibility_extinction(float visibility) { return static_cast<float>(KOSCHMIEDER / double(visibility)); }
+
+Either read_either(const SceneObject& o, const char* a, const char* a_what, const char* b, const char* b_what) {
+    const auto va = o.opt(a);
+    const auto vb = o.opt(b);
+    if (va && vb) fail(Kind::value, vb->field, std::string("give either ") + a_what + " or " + b_what + ", not both");
+    if (va) return Either{true, *va};
+    if (vb) return Either{false, *vb};
+    fail(Kind::value, join_path(o.path, a), std::string("missing required key: give ") + a_what + " or " + b_what);
+}
+
 // --- writing -----------------------------------------------------------------
 
 double json_number(float f) {

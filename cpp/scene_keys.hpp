@@ -93,6 +93,22 @@ Rgb read_rgb(const Value& v, double hi = max_radiometric);
 // PHASE_G_LIMIT anyway), so that the written scene reloads.
 float read_asymmetry(const Value& v);
 
+// A visibility in metres, in [3.912e-3, 1e9] (Koschmieder, docs/conventions.md section 4; the
+// lower bound keeps sigma_t within max_extinction).
+float read_visibility(const Value& v);
+// The extinction (1/m, float) of a visibility read by read_visibility: KOSCHMIEDER / V.
+float visibility_extinction(float visibility);
+
+// The one given of two alternative keys of `o`, `a` or `b`; `a_what` and
+// `b_what` name them with their units in the messages ("visibility (m)").
+// Fails on b's field when both are given, on a's when neither is. `first` is
+// true when the key given is `a`.
+struct Either {
+    bool first;
+    Value value;
+};
+Either read_either(const SceneObject& o, const char* a, const char* a_what, const char* b, const char* b_what);
+
 // A name of `table`; `what` names the kind in the error ("unknown <what> type").
 template <class E>
 E read_enum(const Value& v, const char* what, const NameTable<E>& table) {

@@ -78,17 +78,11 @@ Atmosphere parse_atmosphere(const SceneObject& o) {
         SceneObject m(*v);
         m.check_keys({"visibility", "coefficient", "scale_height", "g", "albedo"});
         a.aerosol.present = true;
-        const auto visibility = m.opt("visibility");
-        const auto coefficient = m.opt("coefficient");
-        if (visibility && coefficient)
-            fail(Kind::value, coefficient->field, "give either a visibility or a coefficient, not both");
-        if (visibility) {
-            a.aerosol.visibility = read_positive(*visibility, 1e9, true);
-        } else if (coefficient) {
-            a.aerosol.coefficient = read_in_range(*coefficient, 0.0, 1e3, " per metre");
-        } else {
-            fail(Kind::value, join_path(m.path, "visibility"), "missing: give a visibility (m) or a coefficient (1/m)");
-        }
+        const Either given = read_either(m, "visibility", "visibility (m)", "coefficient", "coefficient (1/m)");
+        if (given.first)
+            a.aerosol.visibility = read_visibility(given.value);
+        else
+            a.aerosol.coefficient = read_in_range(given.value, 0.0, 1e3, " per metre");
         if (auto d = m.opt("scale_height")) a.aerosol.scale_height = read_positive(*d, 1e5, true);
         if (auto d = m.opt("g")) a.aerosol.g = read_asymmetry(*d);
         if (auto d = m.opt("albedo")) a.aerosol.albedo = read_in_range(*d, 0.0, 1.0);

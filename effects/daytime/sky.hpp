@@ -17,8 +17,6 @@ namespace airlight {
 // values of the source paper (effects/daytime/physics.md), as in Bruneton's precomputed atmosphere), scale height.
 inline constexpr double RAYLEIGH_SIGMA_S0[3] = {5.802e-6, 13.558e-6, 33.1e-6};
 inline constexpr double RAYLEIGH_SCALE_HEIGHT = 8000.0;
-// Koschmieder: visibility V = 3.912 / sigma_t (2 % contrast threshold).
-inline constexpr double KOSCHMIEDER = 3.912;
 // The aerosol's low-altitude profile (seed section 1.1.1): exponential decay
 // to a minimum at 2250 m, a rise by 25 % up to 3250 m, decay above.
 inline constexpr double AEROSOL_MIN_ALTITUDE = 2250.0;

@@ -33,9 +33,29 @@ struct Image {
 };
 
 // True when an OpenGL 4.5 core context can be created through EGL here; on
-// false, `reason` (if given) says why. Setting AIRLIGHT_DISABLE_GL=1 makes it
-// false, to exercise the CPU fallback.
-bool gl_backend_available(std::string* reason = nullptr);
+// false, `reason` (if given) says why; on true, `gl_renderer` (if given) is the
+// context's GL_RENDERER string. Setting AIRLIGHT_DISABLE_GL=1 makes it false,
+// to exercise the CPU fallback.
+bool gl_backend_available(std::string* reason = nullptr, std::string* gl_renderer = nullptr);
+
+// True for the GL_RENDERER of a software rasteriser: Mesa's llvmpipe, softpipe
+// or swrast (case-insensitive), which run on the CPU's cores.
+bool is_software_gl_renderer(const std::string& gl_renderer);
+
+// What Backend "auto" (Python's backend="auto", the demo's --backend auto)
+// picks here, and why: GL where a hardware OpenGL 4.5 context works; the CPU
+// where GL cannot run, and also where the only GL is a software rasteriser
+// (llvmpipe on a machine without a GPU), which shares the CPU backend's cores
+// and pays a 40 times larger set-up (README "Measurements"). Backend::gl stays
+// available explicitly.
+struct AutoBackend {
+    Backend backend = Backend::cpu;
+    bool gl_available = false;
+    std::string gl_renderer;            // GL_RENDERER where GL is available, else empty
+    bool gl_software = false;           // gl_renderer is a software rasteriser
+    std::string gl_unavailable_reason;  // why GL cannot run, else empty
+};
+AutoBackend choose_auto_backend();
 
 // Keeps what is expensive to set up (the GL context, compiled shader variants,
 // and later the scattering tables) across frames, so that animations pay the

@@ -45,10 +45,18 @@ struct Phase {
     float forward_weight = 1.0f;  // hg2
 };
 
+// Koschmieder's law with the 2 % contrast threshold (docs/conventions.md section
+// 4): an extinction sigma_t (1/m) has the visibility V = KOSCHMIEDER / sigma_t (m).
+inline constexpr double KOSCHMIEDER = 3.912;
+
 // Homogeneous participating medium filling all space (docs/conventions.md):
-// sigma_t extinction in 1/m, albedo = sigma_s / sigma_t.
+// sigma_t extinction in 1/m, albedo = sigma_s / sigma_t. A scene may give the
+// medium by its visibility V instead (the same on every channel): sigma_t =
+// float(KOSCHMIEDER / V); `visibility` then records V, and the medium is
+// written back by its visibility while sigma_t still equals that value.
 struct Medium {
     Rgb sigma_t{0.0f};
+    float visibility = 0.0f;  // m; > 0 when the scene gave the visibility
     Rgb albedo{1.0f};
     Phase phase;
 

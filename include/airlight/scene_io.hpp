@@ -24,12 +24,27 @@ private:
     std::string field_;
 };
 
-// Parses and validates a scene from JSON text. Throws SceneError.
+// A scene file that cannot be opened or read (a value error with no field):
+// "scene file not found: PATH" or "cannot read scene file PATH: REASON".
+class SceneFileError : public SceneError {
+public:
+    explicit SceneFileError(const std::string& message) : SceneError(Kind::value, "", message) {}
+};
+
+// Parses and validates a scene from JSON text. Throws SceneError; text that is
+// not JSON is a value error with no field, "invalid JSON at line L, column C:
+// what the parser expected".
 Scene parse_scene(const std::string& json_text);
 
-// Reads a JSON file and parses it. Throws SceneError (a missing or unreadable
-// file is a value error on the field "path").
+// Reads a JSON file and parses it. Throws SceneFileError for a missing or
+// unreadable file, SceneError for its contents.
 Scene load_scene_file(const std::string& path);
+
+// The film size asked for by a width and/or a height, 0 meaning not given (the
+// demo's --width/--height, Python's render(width=, height=)): both given, that
+// size; one alone keeps the film's aspect ratio, the other side rounded to the
+// nearest integer (halves up) and at least 1; neither, the film unchanged.
+Film resize_film(const Film& film, int width, int height);
 
 // Writes a scene back as JSON with every default filled in and every RGB
 // value expanded to a triple; parse_scene(scene_to_json(s)) == s.

@@ -1,6 +1,7 @@
-"""Rendering: backend discovery and selection (``"gl"``, ``"cpu"``, ``"auto"``),
-the :class:`Renderer` that keeps its backend's state across frames, one-frame
-:func:`render`, and :func:`table_stats` on the scattering tables built."""
+"""Rendering: backend discovery and selection (``"gl"``, ``"cpu"``, ``"auto"``;
+:func:`backend_info`), the :class:`Renderer` that keeps its backend's state across
+frames, one-frame :func:`render`, and :func:`table_stats` on the scattering tables
+built."""
 
 from __future__ import annotations
 
@@ -32,17 +33,38 @@ def gl_unavailable_reason() -> str | None:
 
 
 def available_backends() -> list[str]:
-    """The backends that can run on this machine: ``["gl", "cpu"]`` or ``["cpu"]``."""
+    """The backends that can run on this machine: ``["gl", "cpu"]`` or ``["cpu"]``
+    (``"gl"`` also where it is a software rasteriser: see :func:`backend_info`)."""
     return ["gl", "cpu"] if gl_unavailable_reason() is None else ["cpu"]
+
+
+def backend_info() -> dict[str, Any]:
+    """Which backend ``"auto"`` picks here, and the GL renderer it found:
+
+    - ``"auto"``: ``"gl"`` or ``"cpu"``, what ``Renderer("auto")`` uses;
+    - ``"gl_available"``: whether an OpenGL 4.5 context works (``backend="gl"`` runs);
+    - ``"gl_renderer"``: its ``GL_RENDERER`` string (e.g. ``"llvmpipe (LLVM 15.0.6, 256
+      bits)"``), None where GL cannot run;
+    - ``"gl_software"``: True where that renderer is a software rasteriser (Mesa's
+      llvmpipe, softpipe or swrast), which runs on the CPU's cores;
+    - ``"gl_unavailable_reason"``: why GL cannot run, None where it can.
+
+    ``"auto"`` is GL only on a hardware renderer: a software one shares the CPU backend's
+    cores and pays a much larger set-up (README, "Measurements"); ask for ``"gl"`` to use
+    it anyway.
+    """
+    return dict(_core.backend_info())
 
 
 class Renderer:
     """Renders scenes, keeping the GL context, compiled shader variants and
     tables across frames so that animations pay the set-up once.
 
-    ``backend`` is ``"gl"``, ``"cpu"`` or ``"auto"`` (GL when an EGL device
-    works, otherwise CPU with one warning). Asking for ``"gl"`` where it cannot
-    run raises :class:`BackendUnavailableError`.
+    ``backend`` is ``"gl"``, ``"cpu"`` or ``"auto"``: GL when an EGL device with a
+    hardware GL renderer works; the CPU where the only GL renderer is a software
+    rasteriser (llvmpipe), and where GL cannot run (then with one warning); see
+    :func:`backend_info`. Asking for ``"gl"`` where it cannot run raises
+    :class:`BackendUnavailableError`.
     """
 
     def __init__(self, backend: str = "auto", *, cpu_threads: int = 0) -> None:
@@ -52,11 +74,10 @@ class Renderer:
         if backend not in _BACKENDS:
             raise ValueError(f"backend: must be one of {', '.join(_BACKENDS)}, got {backend!r}")
         if backend == "auto":
-            reason = gl_unavailable_reason()
-            if reason is None:
-                backend = "gl"
-            else:
-                backend = "cpu"
+            info = backend_info()
+            backend = info["auto"]
+            reason = info["gl_unavailable_reason"]
+            if reason is not None:
                 if not _warned_fallback:
                     warnings.warn(f"airlight: GL backend unavailable ({reason}); using the CPU backend",
                                   RuntimeWarning, stacklevel=2)
@@ -87,7 +108,9 @@ class Renderer:
     def render(self, scene: SceneLike, *, width: int | None = None,
                height: int | None = None) -> np.ndarray:
         """Linear radiance of ``scene``: float32 array (height, width, 3), row 0
-        on top. ``width``/``height`` override the scene's film size."""
+        on top. ``width``/``height`` override the scene's film size; one of them alone
+        keeps the film's aspect ratio (``render(scene, width=160)`` of a 320x240 film
+        is 160x120: the other side rounded to the nearest integer, at least 1)."""
         return self._active().render(_with_film_size(scene, width, height))
 
     def close(self) -> None:

@@ -17,6 +17,7 @@ SceneLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
 """A scene dict, a path to a JSON scene file, or JSON text."""
 
 _SCENES_DIR = Path(__file__).resolve().parent / "scenes"
+_MAX_FILM_SIZE = 16384
 
 
 def _scene_source(scene: SceneLike) -> Any:
@@ -29,10 +30,12 @@ def _scene_source(scene: SceneLike) -> Any:
             return text
         try:
             return Path(text).read_text(encoding="utf-8")
+        except FileNotFoundError:
+            raise ValueError(f"scene file not found: {text}") from None
         except OSError as exc:
-            raise ValueError(f"path: cannot read scene file {text!r}: {exc.strerror}") from None
+            raise ValueError(f"cannot read scene file {text}: {exc.strerror}") from None
         except (ValueError, UnicodeError) as exc:  # embedded NUL, undecodable bytes
-            raise ValueError(f"path: cannot read scene file {text!r}: {exc}") from None
+            raise ValueError(f"cannot read scene file {text!r}: {exc}") from None
     raise TypeError(f"scene: expected a dict, a path or JSON text, got {type(scene).__name__}")
 
 
@@ -45,14 +48,24 @@ def load_scene(scene: SceneLike) -> dict[str, Any]:
     return json.loads(_core.validate_scene(_scene_source(scene)))
 
 
+def _is_film_size(value: object) -> bool:
+    return isinstance(value, int) and not isinstance(value, bool) and 1 <= value <= _MAX_FILM_SIZE
+
+
 def _with_film_size(scene: SceneLike, width: int | None, height: int | None) -> Any:
-    """The scene source of ``scene`` with its film size overridden where given."""
+    """The scene source of ``scene`` with its film size overridden where given: one of
+    ``width`` and ``height`` alone keeps the film's aspect ratio (the other side rounded,
+    at least 1; ``airlight::resize_film``). Bad values are left for the validator to name."""
     source = _scene_source(scene)
     if width is None and height is None:
         return source
     data = json.loads(source) if isinstance(source, str) else copy.deepcopy(dict(source))
     film = data.get("film")
     film = dict(film) if isinstance(film, Mapping) else {}
+    given = width if height is None else height if width is None else None
+    if given is not None and _is_film_size(given) and all(
+            _is_film_size(film.get(k)) for k in ("width", "height")):
+        width, height = _core.resize_film(film["width"], film["height"], width or 0, height or 0)
     if width is not None:
         film["width"] = width
     if height is not None:

@@ -290,6 +290,37 @@ const std::vector<BadCase> bad_cases = {
      Kind::value, "medium.albedo", "must be <= 1"},
     {"medium albedo < 0", [](json& j) { j["medium"]["albedo"] = -0.1; }, Kind::value, "medium.albedo", "must be >= 0"},
     {"medium typo", [](json& j) { j["medium"]["sigma"] = 1; }, Kind::value, "medium.sigma", "did you mean 'sigma_t'?"},
+    // A medium given by its visibility (issue 17): exactly one of sigma_t and visibility.
+    {"medium both amounts", [](json& j) { j["medium"]["visibility"] = 100; }, Kind::value, "medium.visibility",
+     "give either sigma_t (1/m) or visibility (m), not both"},
+    {"medium without amount", [](json& j) { j["medium"].erase("sigma_t"); }, Kind::value, "medium.sigma_t",
+     "or visibility (m)"},
+    {"medium visibility zero",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = 0;
+     },
+     Kind::value, "medium.visibility", "must be > 0"},
+    {"medium visibility negative",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = -50;
+     },
+     Kind::value, "medium.visibility", "must be > 0"},
+    {"medium visibility huge",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = 2e9;
+     },
+     Kind::value, "medium.visibility", "must be <= 1e+09"},
+    {"medium visibility list",
+     [](json& j) {
+         j["medium"].erase("sigma_t");
+         j["medium"]["visibility"] = {100, 100, 100};
+     },
+     Kind::type, "medium.visibility", "expected a number"},
+    {"medium visibility typo", [](json& j) { j["medium"]["visibilty"] = 100; }, Kind::value, "medium.visibilty",
+     "did you mean 'visibility'?"},
     {"phase unknown type", [](json& j) { j["medium"]["phase"]["type"] = "mie"; }, Kind::value, "medium.phase.type",
      "isotropic"},
     {"hg without g", [](json& j) { j["medium"]["phase"]["type"] = "hg"; }, Kind::value, "medium.phase.g",
@@ -746,6 +777,19 @@ void test_text_errors() {
     check_text_error("{\"film\": ", Kind::value, "", "invalid JSON");
     check_text_error("", Kind::value, "", "invalid JSON");
     check_text_error("{\"film\": {\"width\": NaN}}", Kind::value, "", "invalid JSON");
+    // Without the parser library's prefix, one line that says where (issue 17).
+    for (const char* text : {"{\"film\": {\"width\": 10,\n\n \"height\": }", "{\"film\" 1}", "", "[1, 2"}) {
+        try {
+            airlight::parse_scene(text);
+            CHECK_MSG(false, std::string("no SceneError for: ") + text);
+        } catch (const SceneError& e) {
+            const std::string what = e.what();
+            CHECK_MSG(what.rfind("invalid JSON at line ", 0) == 0, what);
+            CHECK_MSG(what.find("json.exception") == std::string::npos && what.find('\n') == std::string::npos, what);
+        }
+    }
+    check_text_error("{\"film\": {\"width\": 10,\n\n \"height\": }", Kind::value, "",
+                     "invalid JSON at line 3, column 12: syntax error while parsing value");
     check_text_error("[1, 2, 3]", Kind::type, "", "scene must be a JSON object");
     check_text_error("\"scene\"", Kind::type, "", "scene must be a JSON object");
     check_text_error("{}", Kind::value, "film", "missing required key");
@@ -1009,6 +1053,24 @@ void test_round_trip() {
     CHECK(g_scene.medium.phase.g < 1.0f && g_scene.medium.phase.g > 0.9999f);
     CHECK(same_scene(g_scene, airlight::parse_scene(airlight::scene_to_json(g_scene))));
 
+    // A medium given by its visibility (issue 17): sigma_t = 3.912 / V on every channel,
+    // written back by its visibility (not sigma_t: the two together are refused), and reloaded
+    // bit for bit; once sigma_t is changed it is written as sigma_t.
+    json foggy = base_scene();
+    foggy["medium"].erase("sigma_t");
+    foggy["medium"]["visibility"] = 97.8;
+    airlight::Scene fog = airlight::parse_scene_json(foggy);
+    CHECK(fog.has_medium && fog.medium.visibility == 97.8f);
+    CHECK(same(fog.medium.sigma_t, glm::vec3(float(3.912 / double(97.8f)))));
+    CHECK(std::abs(fog.medium.sigma_t.y - 0.04f) < 1e-6f);
+    json fog_json = airlight::scene_to_json_value(fog);
+    CHECK(fog_json["medium"]["visibility"] == 97.8 && !fog_json["medium"].contains("sigma_t"));
+    const airlight::Scene fog_again = airlight::parse_scene(airlight::scene_to_json(fog));
+    CHECK(same_scene(fog, fog_again) && fog_again.medium.visibility == fog.medium.visibility);
+    fog.medium.sigma_t.x = 0.5f;
+    json edited = airlight::scene_to_json_value(fog);
+    CHECK(!edited["medium"].contains("visibility") && edited["medium"]["sigma_t"][0] == 0.5);
+
     // No medium: written as null.
     airlight::Scene clear = s;
     clear.has_medium = false;
@@ -1065,13 +1127,15 @@ void test_round_trip() {
                              : json{{"model", "cie"}, {"type", type}, {"zenith_radiance", {unit(rng), 1, 2}}};
             j["sun"] = i % 4 < 2 ? json{{"elevation", 180.0 * unit(rng) - 90.0}, {"azimuth", coord(rng)}}
                                  : json{{"direction", vec()}, {"irradiance", std::pow(10.0, expo(rng))}};
-            j["atmosphere"] = {{"molecules", {{"density_scale", unit(rng)}}},
-                               {"aerosol",
-                                {{i % 5 ? "visibility" : "coefficient", std::pow(10.0, expo(rng) - 1.0)},
-                                 {"scale_height", 1e4 * unit(rng) + 1.0},
-                                 {"g", 2.0 * unit(rng) - 1.0},
-                                 {"albedo", unit(rng)}}},
-                               {"rain", {{"rate", 100.0 * unit(rng)}, {"top", 1.0 + 3e3 * unit(rng)}}}};
+            j["atmosphere"] = {
+                {"molecules", {{"density_scale", unit(rng)}}},
+                {"aerosol",
+                 {i % 5 ? json::array({"visibility", std::pow(10.0, 0.5 * expo(rng) + 2.0)})  // 1 cm to 10 km
+                        : json::array({"coefficient", std::pow(10.0, expo(rng) - 1.0)}),
+                  {"scale_height", 1e4 * unit(rng) + 1.0},
+                  {"g", 2.0 * unit(rng) - 1.0},
+                  {"albedo", unit(rng)}}},
+                {"rain", {{"rate", 100.0 * unit(rng)}, {"top", 1.0 + 3e3 * unit(rng)}}}};
             if (i % 7 == 0) j["atmosphere"].erase("aerosol");
             j["quality"] = {{"sky_segments", 2 + i % 63}};
         }
@@ -1093,17 +1157,20 @@ void test_round_trip() {
 }
 
 void test_files() {
+    // A missing or unreadable file says so, with the path (issue 17: no bare "path:" label).
     try {
         airlight::load_scene_file("/nonexistent/scene.json");
         CHECK(false);
-    } catch (const SceneError& e) {
-        CHECK(e.kind() == Kind::value && e.field() == "path");
+    } catch (const airlight::SceneFileError& e) {
+        CHECK(e.kind() == Kind::value && e.field().empty());
+        CHECK_MSG(std::string(e.what()) == "scene file not found: /nonexistent/scene.json", e.what());
     }
     try {
         airlight::load_scene_file("/tmp");  // a directory
         CHECK(false);
-    } catch (const SceneError& e) {
-        CHECK(e.kind() == Kind::value && e.field() == "path");
+    } catch (const airlight::SceneFileError& e) {
+        CHECK(e.kind() == Kind::value && e.field().empty());
+        CHECK_MSG(std::string(e.what()) == "cannot read scene file /tmp: Is a directory", e.what());
     }
     std::string path = "/tmp/airlight_test_scene_" + std::to_string(std::random_device{}()) + ".json";
     if (std::FILE* f = std::fopen(path.c_str(), "wb")) {

@@ -36,8 +36,63 @@ def test_gl_renderer_reports_its_backend_when_available() -> None:
         pytest.skip(f"GL backend unavailable: {airlight.gl_unavailable_reason()}")
     with airlight.Renderer("gl") as r:
         assert r.backend == "gl"
+    software = airlight.backend_info()["gl_software"]
     with airlight.Renderer("auto") as r:
-        assert r.backend == "gl", "auto must pick GL where it runs"
+        if software:
+            assert r.backend == "cpu", "auto must pick the CPU where the only GL is a software rasteriser"
+        else:
+            assert r.backend == "gl", "auto must pick GL where a hardware GL renderer runs"
+
+
+def test_backend_info_says_which_gl_renderer_auto_found() -> None:
+    """backend_info() names the GL renderer and the choice of "auto" (issue 17): GL only on a
+    hardware renderer; consistent with available_backends() and gl_unavailable_reason()."""
+    info = airlight.backend_info()
+    assert set(info) == {"auto", "gl_available", "gl_renderer", "gl_software", "gl_unavailable_reason"}
+    assert info["gl_available"] == ("gl" in airlight.available_backends())
+    assert info["gl_unavailable_reason"] == airlight.gl_unavailable_reason()
+    if info["gl_available"]:
+        assert isinstance(info["gl_renderer"], str) and info["gl_renderer"]
+        assert info["gl_software"] == airlight._core.is_software_gl_renderer(info["gl_renderer"])
+    else:
+        assert info["gl_renderer"] is None and info["gl_software"] is False
+    assert info["auto"] == ("gl" if info["gl_available"] and not info["gl_software"] else "cpu")
+    with airlight.Renderer("auto") as r:
+        assert r.backend == info["auto"]
+
+
+@pytest.mark.parametrize(("name", "software"), [
+    ("llvmpipe (LLVM 15.0.6, 256 bits)", True),
+    ("softpipe", True),
+    ("Mesa X11 swrast", True),
+    ("LLVMPIPE (LLVM 17.0.6, 128 bits)", True),
+    ("NVIDIA H200/PCIe/SSE2", False),
+    ("AMD Radeon RX 7900 XTX (radeonsi, navi31, LLVM 15.0.7, DRM 3.54, 6.5.0)", False),
+    ("Mesa Intel(R) UHD Graphics 620 (KBL GT2)", False),
+    ("", False),
+])
+def test_software_gl_renderers_are_recognised(name: str, software: bool) -> None:
+    assert airlight._core.is_software_gl_renderer(name) is software
+
+
+def test_auto_picks_the_cpu_on_a_software_gl_renderer_and_gl_stays_explicit(scene_factory) -> None:
+    """Where GL is Mesa's llvmpipe (these machines), "auto" renders on the CPU, without a
+    warning, and backend="gl" still renders on llvmpipe."""
+    info = airlight.backend_info()
+    if not info["gl_software"]:
+        found = info["gl_renderer"] or info["gl_unavailable_reason"]
+        pytest.skip(f"the GL renderer is not a software one: {found}")
+    import warnings
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        with airlight.Renderer("auto") as r:
+            assert r.backend == "cpu"
+            auto = r.render(scene_factory(), width=16, height=12)
+    np.testing.assert_array_equal(auto, airlight.render(scene_factory(), backend="cpu", width=16, height=12))
+    with airlight.Renderer("gl") as r:
+        assert r.backend == "gl"
+        assert r.render(scene_factory(), width=16, height=12).shape == (12, 16, 3)
 
 
 def test_cpu_renderer_reports_its_backend() -> None:
@@ -49,7 +104,8 @@ _DISABLED_GL_SCRIPT = """
     import json, warnings
     import numpy as np
     import airlight
-    result = {"reason": airlight.gl_unavailable_reason(), "backends": airlight.available_backends()}
+    result = {"reason": airlight.gl_unavailable_reason(), "backends": airlight.available_backends(),
+              "info": airlight.backend_info()}
     try:
         airlight.Renderer("gl")
         result["gl"] = "no error"
@@ -82,6 +138,9 @@ def disabled_gl_result() -> dict:
 def test_disabled_gl_is_reported_unavailable_with_a_reason(disabled_gl_result: dict) -> None:
     assert disabled_gl_result["backends"] == ["cpu"]
     assert "AIRLIGHT_DISABLE_GL" in disabled_gl_result["reason"]
+    assert disabled_gl_result["info"] == {
+        "auto": "cpu", "gl_available": False, "gl_renderer": None, "gl_software": False,
+        "gl_unavailable_reason": disabled_gl_result["reason"]}
 
 
 def test_requesting_gl_where_unavailable_raises_backend_unavailable_error(disabled_gl_result: dict) -> None:

@@ -116,9 +116,24 @@ def test_width_and_height_arguments_override_the_film(renderer: airlight.Rendere
     explicit = renderer.render(scene_factory(film={"width": 40, "height": 30}))
     assert overridden.shape == (30, 40, 3)
     np.testing.assert_array_equal(overridden, explicit)
-    assert renderer.render(scene, width=24).shape == (120, 24, 3)
-    assert renderer.render(scene, height=18).shape == (18, 160, 3)
     assert scene["film"] == {"width": 160, "height": 120}, "the caller's scene must not be modified"
+
+
+@pytest.mark.parametrize(("film", "width", "height", "shape"), [
+    ((160, 120), 24, None, (18, 24)),      # one side alone keeps the aspect ratio (issue 17)
+    ((160, 120), None, 18, (18, 24)),
+    ((320, 240), 160, None, (120, 160)),
+    ((320, 240), None, 7, (7, 9)),         # 9.33 -> 9
+    ((320, 240), 10, None, (8, 10)),       # 7.5 -> 8: halves round up
+    ((320, 240), 1, None, (1, 1)),         # 0.75 -> 1
+    ((1000, 10), 50, None, (1, 50)),       # 0.5 -> 1, never 0
+    ((10, 1000), None, 30, (30, 1)),       # 0.3 -> at least 1
+])
+def test_width_or_height_alone_keeps_the_film_aspect_ratio(scene_factory, film, width, height,
+                                                          shape) -> None:
+    scene = scene_factory(film={"width": film[0], "height": film[1]})
+    assert airlight.render(scene, backend="cpu", width=width, height=height).shape == (*shape, 3)
+    assert scene["film"] == {"width": film[0], "height": film[1]}, "the caller's scene must not be modified"
 
 
 def test_film_override_applies_to_json_text_and_files(

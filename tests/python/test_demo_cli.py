@@ -66,11 +66,33 @@ def test_demo_uses_the_scene_film_size_without_overrides(tmp_path: Path, scene_f
         assert np.asarray(png).any()
 
 
+@pytest.mark.parametrize(("args", "size"), [(["--width", "40"], (40, 30)), (["--height", "45"], (60, 45)),
+                                            (["--width", "40", "--height", "10"], (40, 10))])
+def test_demo_width_or_height_alone_keeps_the_aspect_ratio(tmp_path: Path, scene_file: Path, args: list[str],
+                                                           size: tuple[int, int]) -> None:
+    """The scene's film is 160x120: --width or --height alone keeps its aspect ratio (issue 17)."""
+    out = tmp_path / "x.png"
+    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", *args)
+    assert proc.returncode == 0, proc.stderr
+    with Image.open(out) as png:
+        assert png.size == size
+
+
 def test_demo_auto_backend_renders(tmp_path: Path, scene_file: Path) -> None:
+    """--backend auto picks what airlight.backend_info() says and names the GL renderer it found
+    (issue 17): the CPU where it is a software rasteriser (llvmpipe)."""
+    import airlight
+
     out = tmp_path / "x.png"
     proc = _demo("--scene", str(scene_file), "--out", str(out), "--width", "16", "--height", "12")
     assert proc.returncode == 0, proc.stderr
     assert out.is_file()
+    info = airlight.backend_info()
+    assert f"({info['auto']} backend" in proc.stdout, proc.stdout
+    if info["gl_available"]:
+        assert f"backend auto: {info['auto']} " in proc.stdout, proc.stdout
+        assert info["gl_renderer"] in proc.stdout, proc.stdout
+        assert proc.stderr == ""
 
 
 @pytest.mark.parametrize(("edit", "field"), [
@@ -92,15 +114,20 @@ def test_demo_bad_scene_exits_nonzero_with_one_line_naming_the_field(
 
 
 def test_demo_invalid_json_exits_nonzero_with_one_line(tmp_path: Path) -> None:
+    """The file, then where the JSON breaks, without the parser library's prefix (issue 17)."""
     path = tmp_path / "broken.json"
     path.write_text('{"film": {"width": 10,\n\n "height": }')
-    _assert_one_line_error(_demo("--scene", str(path), "--out", str(tmp_path / "x.png"), "--backend", "cpu"),
-                           "JSON")
+    proc = _demo("--scene", str(path), "--out", str(tmp_path / "x.png"), "--backend", "cpu")
+    line = _assert_one_line_error(proc, "JSON")
+    assert line.startswith(f"airlight-demo: {path}: invalid JSON at line 3, column 12: syntax error"), line
+    assert "json.exception" not in line, line
 
 
 def test_demo_missing_scene_file_exits_nonzero_with_one_line(tmp_path: Path) -> None:
     missing = tmp_path / "missing.json"
-    _assert_one_line_error(_demo("--scene", str(missing), "--out", str(tmp_path / "x.png")), str(missing))
+    proc = _demo("--scene", str(missing), "--out", str(tmp_path / "x.png"))
+    line = _assert_one_line_error(proc, str(missing))
+    assert line == f"airlight-demo: scene file not found: {missing}", line
 
 
 @pytest.mark.parametrize("args", [["--bogus", "1"], ["--bogus"], ["-x"], ["extra"]])
@@ -160,6 +187,38 @@ def test_demo_help_exits_zero_with_usage() -> None:
         assert proc.stderr == ""
 
 
+def test_demo_help_documents_the_window_and_its_keys() -> None:
+    """--help shows --window without a required --out and every key of the window (issue 17:
+    Esc was not documented)."""
+    proc = _demo("--help")
+    assert proc.returncode == 0
+    assert "--window [--out" in proc.stdout, proc.stdout
+    for key in ("W/S", "A/D", "Q/E", "arrow keys", "+/-", "Esc"):
+        assert key in proc.stdout, (key, proc.stdout)
+
+
+def test_demo_window_needs_no_out(tmp_path: Path, scene_file: Path) -> None:
+    """--window without --out is accepted (the last frame is saved only when --out is given):
+    here, without a display, it fails only for want of a window, on one line."""
+    if not DEMO.exists():
+        pytest.skip(f"{DEMO} is not installed")
+    env = {k: v for k, v in os.environ.items() if k not in ("DISPLAY", "WAYLAND_DISPLAY")}
+    proc = subprocess.run([str(DEMO), "--scene", str(scene_file), "--window", "--backend", "cpu"],
+                          capture_output=True, text=True, timeout=60, env=env)
+    line = _assert_one_line_error(proc, "window")
+    assert "--out" not in line, line
+
+
+@pytest.mark.parametrize(("args", "needle"), [
+    (["--window", "--sequence", "approaching-car", "--out", "{tmp}/frames"], "--window"),
+    (["--window", "--out", "{tmp}/x.jpg"], "--out"),
+])
+def test_demo_bad_window_options_exit_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
+                                                            args: list[str], needle: str) -> None:
+    _assert_one_line_error(_demo("--scene", str(scene_file), *(a.format(tmp=tmp_path) for a in args)), needle)
+    assert not any(tmp_path.glob("frames*")) and not (tmp_path / "x.jpg").exists()
+
+
 def _demo_without_gl(*args: str) -> subprocess.CompletedProcess:
     if not DEMO.exists():
         pytest.skip(f"{DEMO} is not installed")
@@ -192,7 +251,7 @@ def test_demo_auto_backend_falls_back_to_cpu_where_gl_is_unavailable(
     (["--white", "0"], "--white"),
     (["--white", "-2"], "--white"),
     (["--sequence", "parade"], "--sequence"),
-    (["--sequence", "approaching-car", "--frames", "1"], "--frames"),
+    (["--sequence", "approaching-car", "--frames", "0"], "--frames"),
     (["--sequence", "approaching-car", "--from", "10", "--to", "20"], "--to"),
 ])
 def test_demo_bad_display_option_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
@@ -208,13 +267,57 @@ def test_demo_bad_display_object_in_the_scene_names_the_field(tmp_path: Path, sc
                            "display.glare.pupil_diameter")
 
 
+def _approaching_car() -> Path:
+    return Path(__file__).resolve().parents[2] / "scenes" / "approaching_car.json"
+
+
+@pytest.mark.parametrize(("args", "names"), [
+    (["--frames", "1", "--from", "20"], ["frame_00_0020m.png"]),
+    (["--frames", "1", "--from", "25", "--to", "10"], ["frame_00_0025m.png"]),
+    (["--frames", "2", "--from", "20", "--to", "20"], ["frame_00_0020m.png", "frame_01_0020m.png"]),
+])
+def test_demo_approaching_car_renders_a_single_distance(tmp_path: Path, args: list[str],
+                                                        names: list[str]) -> None:
+    """One frame (at --from), or --from equal to --to, is a sequence too (issue 17): at 20-25 m
+    the car's two headlights are two bright spots either side of a darker middle."""
+    out = tmp_path / "frames"
+    proc = _demo("--scene", str(_approaching_car()), "--out", str(out), "--backend", "cpu", "--sequence",
+                 "approaching-car", "--width", "64", "--height", "36", "--exposure", "1", *args)
+    assert proc.returncode == 0, proc.stderr
+    assert sorted(p.name for p in out.iterdir()) == names
+    for name in names:
+        with Image.open(out / name) as png:
+            row = np.asarray(png.convert("RGB")).astype(int)[16:20, :, 1].max(axis=0)
+        left, right = int(np.argmax(row[:32])), 32 + int(np.argmax(row[32:]))
+        assert min(row[left], row[right]) > 150 and left < 30 and right > 33, row.tolist()
+        assert row[31:33].max() < 0.8 * min(row[left], row[right]), row.tolist()
+
+
+def test_demo_approaching_car_needs_the_car_in_the_scene(tmp_path: Path, scene_factory) -> None:
+    path = _write_scene(tmp_path, scene_factory(lights=[]))
+    proc = _demo("--scene", str(path), "--out", str(tmp_path / "frames"), "--sequence", "approaching-car")
+    _assert_one_line_error(proc, "approaching-car", "lights")
+
+
+def test_demo_renders_the_approaching_car_preset_alone(tmp_path: Path) -> None:
+    """scenes/approaching_car.json without --sequence shows the car 200 m away: two headlights
+    (not a black frame)."""
+    out = tmp_path / "car.png"
+    proc = _demo("--scene", str(_approaching_car()), "--out", str(out), "--backend", "cpu", "--width", "160",
+                 "--height", "90", "--exposure", "1")
+    assert proc.returncode == 0, proc.stderr
+    with Image.open(out) as png:
+        pixels = np.asarray(png.convert("RGB")).astype(int)
+    assert pixels.max() > 200, "the preset renders black"
+
+
 @pytest.mark.slow
 def test_demo_renders_the_approaching_car_sequence(tmp_path: Path, backend: str) -> None:
     """The headlight experiment: one PNG per distance, named by frame and distance; at 2 km
     the two headlights are one spot in the middle, at 20 m two spots either side of a
     darker middle (1.5 m apart: 5.5 pixels each side at 14 degrees over 36 rows). Pixels 10
     times the scene's on a side hold 100 times the solid angle: exposure 1, not 0.01."""
-    scene = Path(__file__).resolve().parents[2] / "scenes" / "approaching_car.json"
+    scene = _approaching_car()
     out = tmp_path / "frames"
     proc = _demo("--scene", str(scene), "--out", str(out), "--backend", backend, "--sequence",
                  "approaching-car", "--frames", "3", "--width", "64", "--height", "36", "--exposure", "1")

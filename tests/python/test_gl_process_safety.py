@@ -66,6 +66,9 @@ def test_forked_child_refuses_gl_with_a_clear_error_instead_of_hanging(tmp_path)
 
 
 def test_fork_pool_workers_render_on_the_cpu_and_spawn_workers_on_gl(tmp_path):
+    """Fork workers: "auto" is the CPU and "gl" is refused; spawn workers: "auto" picks what it
+    picks in a fresh process (GL on a hardware renderer, the CPU on llvmpipe: backend_info,
+    issue 17) and "gl" renders. Every worker's frame matches the parent's GL frame."""
     skip_unless_backend_available("gl")
     out = run_script(tmp_path, """
         import multiprocessing as mp, warnings
@@ -74,17 +77,27 @@ def test_fork_pool_workers_render_on_the_cpu_and_spawn_workers_on_gl(tmp_path):
         def work(seed):
             scene = airlight.load_scene("scenes/default.json")
             r = airlight.Renderer("auto")
-            return r.backend, float(r.render(scene, width=16, height=12).sum())
+            auto = float(r.render(scene, width=16, height=12).sum())
+            try:
+                gl = float(airlight.Renderer("gl").render(scene, width=16, height=12).sum())
+            except airlight.BackendUnavailableError:
+                gl = None
+            return r.backend, auto, gl
         if __name__ == "__main__":
             scene = airlight.load_scene("scenes/default.json")
-            ref = airlight.render(scene, backend="gl", width=16, height=12)
+            ref = float(airlight.render(scene, backend="gl", width=16, height=12).sum())
+            close = lambda s: abs(s - ref) <= 1e-3 * ref
             for method in ("fork", "spawn"):
                 with mp.get_context(method).Pool(2) as pool:
                     results = pool.map(work, range(2))
-                print(method, sorted({b for b, _ in results}),
-                      all(abs(s - float(ref.sum())) <= 1e-3 * float(ref.sum()) for _, s in results))
+                backends = sorted({b for b, _, _ in results})
+                autos_close = all(close(a) for _, a, _ in results)
+                gl = [g for _, _, g in results]
+                gl_state = "gl refused" if all(g is None for g in gl) else all(g and close(g) for g in gl)
+                print(method, backends, autos_close, gl_state)
     """, timeout=120)
-    assert out.splitlines() == ["fork ['cpu'] True", "spawn ['gl'] True"]
+    auto = airlight.backend_info()["auto"]
+    assert out.splitlines() == ["fork ['cpu'] True gl refused", f"spawn ['{auto}'] True True"]
 
 
 def test_a_gl_renderer_serves_other_threads_one_call_at_a_time():

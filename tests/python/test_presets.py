@@ -59,3 +59,24 @@ def test_forward_scattering_street_tightens_the_halos():
         ratios.append(near / far)
     print(f"halo ratios near/far: isotropic {ratios[0]:.2f}, hg {ratios[1]:.2f}")
     assert ratios[1] > 2 * ratios[0], f"halo ratios near/far: isotropic {ratios[0]:.2f}, hg {ratios[1]:.2f}"
+
+
+def test_approaching_car_preset_shows_the_car():
+    """approaching_car renders the car on its own (issue 17; it was black, its headlights only
+    in the demo's sequence): two spot lights 1.5 m apart 200 m ahead, aimed at the camera, each
+    imaged as a bright core where _pixel_of puts it, with darker sky between them."""
+    scene = airlight.preset("approaching_car")
+    spots = [light for light in scene["lights"] if light["type"] == "spot"]
+    assert len(spots) == 2
+    a, b = (np.array(s["position"], float) for s in spots)
+    assert abs(np.linalg.norm(a - b) - 1.5) < 1e-9 and a[2] == b[2] == -200.0
+    scene["film"] = {"width": 320, "height": 180}  # 1.36 mrad pixels: the lamps 5.5 pixels apart
+    image = airlight.render(scene, backend="cpu")[..., 1]
+    cores = []
+    for lamp in (a, b):
+        col, row = _pixel_of(scene, lamp)
+        cores.append(image[int(row) - 1:int(row) + 2, int(col) - 1:int(col) + 2].max())
+    col_a, row_a = _pixel_of(scene, a)
+    col_b, _ = _pixel_of(scene, b)
+    between = image[int(row_a), int((col_a + col_b) / 2)]
+    assert min(cores) > 100 * max(between, 1e-30) and min(cores) > 1.0, (cores, between)

@@ -264,6 +264,39 @@ def test_valid_base_scene_loads_and_is_normalised() -> None:
     assert loaded["medium"]["sigma_t"] == pytest.approx([0.05] * 3)
 
 
+def _foggy(**medium: object) -> dict:
+    scene = copy.deepcopy(VALID)
+    scene["medium"] = {k: v for k, v in {**scene["medium"], **medium}.items() if v is not None}
+    return scene
+
+
+def test_medium_given_by_its_visibility_renders_as_koschmieder_sigma_t() -> None:
+    """medium.visibility V (m) is the night fog's alternative to sigma_t (issue 17), as for the
+    daytime aerosol: sigma_t = 3.912 / V on every channel; the loaded scene keeps the
+    visibility (not both keys, which are refused together), reloads to itself, and renders
+    exactly as the same medium given by sigma_t."""
+    by_visibility = _foggy(sigma_t=None, visibility=97.8)
+    loaded = airlight.load_scene(by_visibility)
+    assert loaded["medium"]["visibility"] == pytest.approx(97.8) and "sigma_t" not in loaded["medium"]
+    assert airlight.load_scene(loaded) == loaded
+    by_sigma = _foggy(sigma_t=float(np.float32(3.912 / np.float64(np.float32(97.8)))))
+    np.testing.assert_array_equal(airlight.render(by_visibility, backend="cpu", width=24, height=16),
+                                  airlight.render(by_sigma, backend="cpu", width=24, height=16))
+
+
+@pytest.mark.parametrize(("medium", "exc", "field", "needle"), [
+    ({"visibility": 100.0}, ValueError, "medium.visibility", "not both"),
+    ({"sigma_t": None}, ValueError, "medium.sigma_t", "visibility"),
+    ({"sigma_t": None, "visibility": 0}, ValueError, "medium.visibility", "> 0"),
+    ({"sigma_t": None, "visibility": -3.0}, ValueError, "medium.visibility", "> 0"),
+    ({"sigma_t": None, "visibility": float("nan")}, ValueError, "medium.visibility", "finite"),
+    ({"sigma_t": None, "visibility": "dense"}, TypeError, "medium.visibility", "number"),
+])
+def test_medium_visibility_errors_name_the_field(medium: dict, exc: type, field: str, needle: str) -> None:
+    with pytest.raises(exc, match=f"^{re.escape(field)}: .*{needle}"):
+        airlight.load_scene(_foggy(**medium))
+
+
 @pytest.mark.parametrize(("mutate", "exc", "field"), [b[1:] for b in BAD_SCENES], ids=BAD_IDS)
 def test_load_scene_rejects_bad_input_naming_the_field(mutate, exc, field) -> None:
     with pytest.raises(exc) as info:
@@ -293,6 +326,23 @@ def test_invalid_json_text_is_a_value_error() -> None:
         airlight.load_scene("{not json")
 
 
+@pytest.mark.parametrize("via", ["text", "file"])
+def test_invalid_json_message_is_one_clean_line_saying_where(tmp_path, via: str) -> None:
+    """The parser library's "[json.exception.parse_error.101] parse error" prefix is not shown
+    (issue 17): the message is one line, "invalid JSON at line L, column C: ...", from JSON text
+    and from a file, through load_scene and render."""
+    text = '{"film": {"width": 10,\n\n "height": }'
+    path = tmp_path / "broken.json"
+    path.write_text(text)
+    source = text if via == "text" else str(path)
+    for call in (airlight.load_scene, lambda s: airlight.render(s, backend="cpu")):
+        with pytest.raises(ValueError) as info:
+            call(source)
+        message = str(info.value)
+        assert message.startswith("invalid JSON at line 3, column 12: syntax error"), message
+        assert "json.exception" not in message and "\n" not in message, message
+
+
 def test_json_file_holding_a_list_is_a_type_error(tmp_path) -> None:
     path = tmp_path / "list.json"
     path.write_text("[1, 2, 3]")
@@ -301,20 +351,25 @@ def test_json_file_holding_a_list_is_a_type_error(tmp_path) -> None:
 
 
 def test_unreadable_path_is_a_value_error_naming_path(tmp_path) -> None:
+    """A missing file says "scene file not found: PATH" (issue 17; it was a bare "path:" label),
+    an unreadable one "cannot read scene file PATH: why"."""
     missing = tmp_path / "does_not_exist.json"
-    with pytest.raises(ValueError, match="^path:"):
+    not_found = f"^scene file not found: {re.escape(str(missing))}$"
+    with pytest.raises(ValueError, match=not_found):
         airlight.load_scene(str(missing))
-    with pytest.raises(ValueError, match="^path:"):
+    with pytest.raises(ValueError, match=not_found):
         airlight.load_scene(missing)
-    with pytest.raises(ValueError, match="^path:"):
+    with pytest.raises(ValueError, match=not_found):
         airlight.render(str(missing), backend="cpu")
-    with pytest.raises(ValueError, match="^path:"):
+    unreadable = f"^cannot read scene file {re.escape(str(tmp_path))}: Is a directory$"
+    with pytest.raises(ValueError, match=unreadable):
         airlight.load_scene(str(tmp_path))  # a directory
 
 
 def test_path_with_a_nul_byte_is_a_value_error_naming_path() -> None:
-    with pytest.raises(ValueError, match="^path:"):
-        airlight.load_scene("scene\0.json")
+    path = "scene\0.json"
+    with pytest.raises(ValueError, match="^" + re.escape(f"cannot read scene file {path!r}: ") + ".*null"):
+        airlight.load_scene(path)
 
 
 def test_bad_film_override_is_rejected_naming_the_film_field() -> None:
