@@ -2,6 +2,7 @@
 // the same shared per-pixel code (shaders/*.glsl).
 #pragma once
 
+#include <atomic>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -45,10 +46,12 @@ struct GlDisplayOutput {
 
 class CpuBackend {
 public:
-    void render(const FrameData& data, Image& out);
+    // `cancel` (optional): polled per row (per batch of pixels); once true, throws RenderCancelled.
+    void render(const FrameData& data, Image& out, const std::atomic<bool>* cancel = nullptr);
     // Recomputes the listed pixels (indices row * width + x) of `out`, a
     // frame of data's film size (the GL backend's cut pixels).
-    void render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out);
+    void render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out,
+                       const std::atomic<bool>* cancel = nullptr);
     // The outputs of data.grid_passes alone, in order (tests).
     std::vector<Table2D> grid_passes(const FrameData& data);
     int threads = 0;  // 0: std::thread::hardware_concurrency()
@@ -64,7 +67,9 @@ public:
     // shader loops the driver cut short (Mesa llvmpipe's loop limiter: see
     // render.frag), which are wrong and must be recomputed (Renderer::render
     // does it on the CPU).
-    void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr);
+    // `cancel` (optional): polled per tile; once true, throws RenderCancelled.
+    void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr,
+                const std::atomic<bool>* cancel = nullptr);
     // The display stage on the GPU (see GlDisplayJob).
     void display(const GlDisplayJob& job, GlDisplayOutput& out);
     // The glare convolution of the display pass alone (FFT on the GPU, fp32, or

@@ -116,7 +116,14 @@ std::vector<Table2D> CpuBackend::grid_passes(const FrameData& data) {
     return tables;
 }
 
-void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out) {
+namespace {
+
+bool cancelled(const std::atomic<bool>* cancel) { return cancel != nullptr && cancel->load(std::memory_order_relaxed); }
+
+}  // namespace
+
+void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out,
+                               const std::atomic<bool>* cancel) {
     const size_t width = size_t(data.frame.film_width);
     if (out.width != data.frame.film_width || out.height != data.frame.film_height)
         throw std::logic_error("airlight: render_pixels needs a frame of the film's size");
@@ -128,6 +135,7 @@ void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>&
     numerics::parallel_for(
         batches,
         [&](int b) {
+            if (cancelled(cancel)) return;
             shader::CpuShader local = program;
             const size_t end = std::min(pixels.size(), size_t(b + 1) * kBatch);
             for (size_t k = size_t(b) * kBatch; k < end; ++k) {
@@ -139,9 +147,10 @@ void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>&
             }
         },
         threads);
+    if (cancelled(cancel)) throw RenderCancelled();
 }
 
-void CpuBackend::render(const FrameData& data, Image& out) {
+void CpuBackend::render(const FrameData& data, Image& out, const std::atomic<bool>* cancel) {
     const int width = data.frame.film_width;
     const int height = data.frame.film_height;
     out.width = width;
@@ -156,6 +165,7 @@ void CpuBackend::render(const FrameData& data, Image& out) {
     numerics::parallel_for(
         height,
         [&](int row) {
+            if (cancelled(cancel)) return;
             shader::CpuShader local = program;  // the shared code's functions are non-const members
             float* dst = out.rgb.data() + size_t(row) * size_t(width) * 3;
             for (int x = 0; x < width; ++x) {
@@ -166,6 +176,7 @@ void CpuBackend::render(const FrameData& data, Image& out) {
             }
         },
         threads);
+    if (cancelled(cancel)) throw RenderCancelled();
 }
 
 }  // namespace airlight

@@ -2,8 +2,10 @@
 // display stage: exposure, glare, tone curve) or PFM (float radiance), or the
 // approaching-car headlight sequence (issue 8). Bad input exits non-zero with
 // a one-line message.
+#include <atomic>
 #include <chrono>
 #include <cmath>
+#include <csignal>
 #include <cstdio>
 #include <cstdlib>
 #include <cstring>
@@ -26,6 +28,8 @@ int run_window(Scene scene, Backend backend, DisplaySettings display, const std:
 #endif
 
 namespace {
+
+std::atomic<bool> interrupted{false};  // set by SIGINT (main); renders poll it
 
 const char* kUsage =
     "usage: airlight-demo --scene S.json --out F.png|F.pfm [--backend auto|gl|cpu]\n"
@@ -236,7 +240,7 @@ int run_sequence(airlight::Scene scene, const Options& o, airlight::Backend back
         frame.camera.look_at = glm::vec3(middle.x, middle.y, double(scene.camera.position.z) - d);
         frame.camera.up = glm::vec3(0.0f, 1.0f, 0.0f);
         const auto start = std::chrono::steady_clock::now();
-        const Image image = renderer.render(frame);
+        const Image image = renderer.render(frame, &interrupted);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
         char name[64];
@@ -267,7 +271,7 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
     // One exposure for the whole sequence (automatic: the full scene's), so
     // that the brightening and the fading show.
     if (settings.exposure_mode == ExposureMode::automatic) {
-        settings.exposure = resolve_exposure(renderer.render(scene), settings);
+        settings.exposure = resolve_exposure(renderer.render(scene, &interrupted), settings);
         settings.exposure_mode = ExposureMode::manual;
     }
     const float density0 = scene.atmosphere.rain.density_scale;
@@ -278,7 +282,7 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
         frame.sun.irradiance = scene.sun.irradiance * float(s * s * (3.0 - 2.0 * s));
         frame.atmosphere.rain.density_scale = float(density0 * std::pow(1e-2, t));
         const auto start = std::chrono::steady_clock::now();
-        const Image image = renderer.render(frame);
+        const Image image = renderer.render(frame, &interrupted);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
         char name[80];
@@ -295,6 +299,8 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
 
 int main(int argc, char** argv) {
     using namespace airlight;
+    // Ctrl-C ends a long render between rows (or GL tiles) with a message.
+    std::signal(SIGINT, [](int) { interrupted = true; });
     const Options o = parse_args(argc, argv);
     if (o.sequence.empty() && !o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm")) {
         fail("--out must end in .png or .pfm, got '" + o.out + "'");
@@ -339,7 +345,7 @@ int main(int argc, char** argv) {
         }
         Renderer renderer(backend);
         const auto start = std::chrono::steady_clock::now();
-        const Image image = renderer.render(scene);
+        const Image image = renderer.render(scene, &interrupted);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         if (ends_with(o.out, ".pfm")) {
             write_pfm(o.out, image);
@@ -349,6 +355,9 @@ int main(int argc, char** argv) {
             write_png(o.out, shown.width, shown.height, shown.srgb8);
             print_report(o.out, image, backend, ms, &shown.report);
         }
+    } catch (const RenderCancelled&) {
+        std::fprintf(stderr, "airlight-demo: interrupted\n");
+        return 130;
     } catch (const std::exception& e) {
         fail(e.what());
     }

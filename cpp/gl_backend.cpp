@@ -149,7 +149,7 @@ void destroy_context(EglContext& c) {
     c = EglContext{};
 }
 
-constexpr int kTile = 2048;  // largest tile drawn at once (GlBackend::render)
+constexpr int kTile = 512;  // largest tile drawn at once (GlBackend::render; a cancel is seen between tiles)
 
 // Iterations of render.frag's last loop, which finishes only where the
 // driver's loop limiter has not cut the pixel's loops.
@@ -363,7 +363,8 @@ GlBackend::~GlBackend() {
     if (!forked_after_egl) destroy_context(state_->egl);
 }
 
-void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels) {
+void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels,
+                       const std::atomic<bool>* cancel) {
     State& s = *state_;
     State::Current current(s);
     const int width = data.frame.film_width;
@@ -420,6 +421,7 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
     for (int y0 = 0; y0 < height; y0 += tile_h) {
         for (int x0 = 0; x0 < width; x0 += tile_w) {
+            if (cancel != nullptr && cancel->load()) throw RenderCancelled();
             const int w = std::min(tile_w, width - x0), h = std::min(tile_h, height - y0);
             if (x0 > 0 || y0 > 0) {
                 frame.tile_origin_x = x0;  // pixel offset of this tile (render.frag)

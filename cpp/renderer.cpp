@@ -58,7 +58,7 @@ DisplayImage Renderer::display(const Image& linear, const DisplaySettings& setti
     return run_display_stage(linear, settings, fov_y_degrees, impl_->cpu.threads, impl_->gl.get());
 }
 
-Image Renderer::render(const Scene& scene) {
+Image Renderer::render(const Scene& scene, const std::atomic<bool>* cancel) {
     std::lock_guard<std::mutex> lock(impl_->mutex);
     const FrameData data = make_frame_data(scene);
     Image image;
@@ -67,11 +67,11 @@ Image Renderer::render(const Scene& scene) {
         // Pixels the GL driver could not finish (its loop limit) are recomputed
         // exactly on the CPU, so every scene is right on every backend.
         std::vector<size_t> cut;
-        impl_->gl->render(data, image, &cut);
-        if (!cut.empty()) impl_->cpu.render_pixels(data, cut, image);
+        impl_->gl->render(data, image, &cut, cancel);
+        if (!cut.empty()) impl_->cpu.render_pixels(data, cut, image, cancel);
         impl_->cpu_fallback_pixels = cut.size();
     } else {
-        impl_->cpu.render(data, image);
+        impl_->cpu.render(data, image, cancel);
     }
     return image;
 }

@@ -37,7 +37,10 @@ AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
 namespace {
 
 constexpr int max_film_size = 16384;
+constexpr long max_film_pixels = 8192L * 8192L;
 constexpr double max_light_radius = 1e3;
+// The largest scene file read (a scene of 10^5 lamps is about 10 MiB).
+constexpr std::size_t max_scene_file_bytes = std::size_t(64) << 20;
 constexpr double default_light_radius = 0.05;
 
 enum class LightType { point, spot };
@@ -72,6 +75,11 @@ Film parse_film(const SceneObject& o) {
     Film f;
     f.width = read_int(o.req("width"), 1, max_film_size);
     f.height = read_int(o.req("height"), 1, max_film_size);
+    // 64 megapixels at most (8192 x 8192: 768 MiB of float RGB), refused before anything is allocated.
+    if (long(f.width) * long(f.height) > max_film_pixels)
+        fail(Kind::value, join_path(o.path, "height"),
+             "film of " + std::to_string(f.width) + " x " + std::to_string(f.height) + " pixels exceeds " +
+                 std::to_string(max_film_pixels) + " pixels (8192 x 8192)");
     return f;
 }
 
@@ -394,13 +402,18 @@ Scene load_scene_file(const std::string& path) {
         if (errno == ENOENT) throw SceneFileError("scene file not found: " + path);
         throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(errno));
     }
+    // Read at most max_scene_file_bytes: '/dev/zero' or a huge file is refused,
+    // not read until memory runs out.
     std::string text;
     char buf[1 << 16];
     std::size_t n;
-    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+    while ((n = std::fread(buf, 1, sizeof buf, f)) > 0 && text.size() <= max_scene_file_bytes) text.append(buf, n);
     int error = std::ferror(f) ? errno : 0;
     std::fclose(f);
     if (error) throw SceneFileError("cannot read scene file " + path + ": " + std::strerror(error));
+    if (text.size() > max_scene_file_bytes)
+        throw SceneFileError("scene file " + path + " is larger than " + std::to_string(max_scene_file_bytes >> 20) +
+                             " MiB");
     return parse_scene(text);
 }
 

@@ -32,7 +32,32 @@ std::string element_prefix(std::size_t i) { return "element " + std::to_string(i
 
 }  // namespace
 
-void fail(Kind kind, const std::string& field, const std::string& message) { throw SceneError(kind, field, message); }
+// `text` fit for a one-line message: control bytes (NUL included, which
+// would end a C string) escaped as \xNN, and cut after kMessagePart bytes
+// (at a UTF-8 character boundary) with the length left out: a 100 MB
+// unknown key is not echoed whole.
+std::string printable(const std::string& text) {
+    constexpr std::size_t kMessagePart = 200;
+    std::string out;
+    std::size_t i = 0;
+    for (; i < text.size() && out.size() < kMessagePart; ++i) {
+        const unsigned char c = static_cast<unsigned char>(text[i]);
+        if (c < 0x20 || c == 0x7f) {
+            char escaped[8];
+            std::snprintf(escaped, sizeof escaped, "\\x%02x", c);
+            out += escaped;
+        } else {
+            out += char(c);
+        }
+    }
+    while (i < text.size() && (static_cast<unsigned char>(text[i]) & 0xC0) == 0x80) out += text[i++];
+    if (i < text.size()) out += "... (" + std::to_string(text.size() - i) + " more bytes)";
+    return out;
+}
+
+void fail(Kind kind, const std::string& field, const std::string& message) {
+    throw SceneError(kind, printable(field), printable(message));
+}
 
 std::string join_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
 
@@ -209,7 +234,7 @@ float read_asymmetry(const Value& v) {
 float read_visibility(const Value& v) {
     const float visibility = read_positive(v, 1e9, true);
     // Koschmieder's sigma_t stays within max_extinction.
-    if (double(visibility) < KOSCHMIEDER / max_extinction)
+    if (visibility < static_cast<float>(KOSCHMIEDER / max_extinction))
         fail(Kind::value, v.field,
              "must be >= " + format_number(KOSCHMIEDER / max_extinction) + " (sigma_t <= 1000 /m)");
     return visibility;

@@ -1,6 +1,7 @@
 // Rendering a scene to linear radiance with the GL or the CPU backend.
 #pragma once
 
+#include <atomic>
 #include <memory>
 #include <stdexcept>
 #include <string>
@@ -22,6 +23,13 @@ const char* backend_name(Backend backend);
 class BackendUnavailable : public std::runtime_error {
 public:
     using std::runtime_error::runtime_error;
+};
+
+// Thrown by Renderer::render when its cancel flag was set (Ctrl-C in Python
+// and in the demo): the frame is abandoned, the renderer stays usable.
+class RenderCancelled : public std::runtime_error {
+public:
+    RenderCancelled() : std::runtime_error("airlight: render interrupted") {}
 };
 
 // Linear radiance, W/(m^2 sr): `rgb` holds width * height RGB triples, row 0
@@ -71,7 +79,9 @@ public:
     Renderer& operator=(const Renderer&) = delete;
 
     Backend backend() const;
-    Image render(const Scene& scene);
+    // `cancel` (optional) is polled while rendering (per row on the CPU, per
+    // tile on GL): once it is true, render throws RenderCancelled.
+    Image render(const Scene& scene, const std::atomic<bool>* cancel = nullptr);
 
     // The display stage (include/airlight/display.hpp, display_image) on this
     // renderer's backend: the GL backend runs the glare convolution and the

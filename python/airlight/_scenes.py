@@ -18,6 +18,7 @@ SceneLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
 
 _SCENES_DIR = Path(__file__).resolve().parent / "scenes"
 _MAX_FILM_SIZE = 16384
+_MAX_SCENE_FILE_BYTES = 64 << 20  # as cpp/scene_io.cpp's max_scene_file_bytes
 
 
 def _scene_source(scene: SceneLike) -> Any:
@@ -26,15 +27,23 @@ def _scene_source(scene: SceneLike) -> Any:
         return scene
     if isinstance(scene, (str, os.PathLike)):
         text = os.fspath(scene)
-        if isinstance(scene, str) and text.lstrip().startswith("{"):
-            return text
+        if isinstance(scene, str) and text.lstrip("\ufeff \t\r\n").startswith("{"):
+            return text.lstrip("\ufeff")  # JSON text, a byte order mark or not
         try:
-            return Path(text).read_text(encoding="utf-8")
+            # At most _MAX_SCENE_FILE_BYTES: '/dev/zero' or a huge file is refused, not read whole.
+            with open(text, "rb") as f:
+                data = f.read(_MAX_SCENE_FILE_BYTES + 1)
         except FileNotFoundError:
             raise ValueError(f"scene file not found: {text}") from None
         except OSError as exc:
             raise ValueError(f"cannot read scene file {text}: {exc.strerror}") from None
-        except (ValueError, UnicodeError) as exc:  # embedded NUL, undecodable bytes
+        except ValueError as exc:  # an embedded NUL in the path
+            raise ValueError(f"cannot read scene file {text!r}: {exc}") from None
+        if len(data) > _MAX_SCENE_FILE_BYTES:
+            raise ValueError(f"scene file {text} is larger than {_MAX_SCENE_FILE_BYTES >> 20} MiB")
+        try:
+            return data.decode("utf-8-sig")
+        except UnicodeError as exc:
             raise ValueError(f"cannot read scene file {text!r}: {exc}") from None
     raise TypeError(f"scene: expected a dict, a path or JSON text, got {type(scene).__name__}")
 

@@ -136,6 +136,12 @@ const std::vector<BadCase> bad_cases = {
     {"camera null", [](json& j) { j["camera"] = nullptr; }, Kind::type, "camera", "expected an object"},
     // Film.
     {"width 0", [](json& j) { j["film"]["width"] = 0; }, Kind::value, "film.width", "must be in [1, 16384]"},
+    {"film beyond 64 megapixels",
+     [](json& j) {
+         j["film"]["width"] = 16384;
+         j["film"]["height"] = 16384;
+     },
+     Kind::value, "film.height", "film of 16384 x 16384 pixels exceeds 67108864 pixels"},
     {"width negative", [](json& j) { j["film"]["width"] = -5; }, Kind::value, "film.width", "must be in"},
     {"width huge", [](json& j) { j["film"]["width"] = 16385; }, Kind::value, "film.width", "must be in"},
     {"height uint64", [](json& j) { j["film"]["height"] = 18446744073709551615ull; }, Kind::value, "film.height",

@@ -676,7 +676,7 @@ def _daytime_keys(draw) -> dict[str, Any]:
     if draw(st.booleans()):
         amount = draw(st.sampled_from(["visibility", "coefficient"]))
         atmosphere["aerosol"] = {
-            amount: draw(st.floats(1e-3, 1e9) if amount == "visibility" else st.floats(0.0, 1e3)),
+            amount: draw(st.floats(3.912e-3, 1e9) if amount == "visibility" else st.floats(0.0, 1e3)),
             "scale_height": draw(st.floats(1.0, 1e5)), "g": draw(_asymmetry),
             "albedo": draw(st.floats(0.0, 1.0))}
     if draw(st.booleans()):

@@ -1,0 +1,69 @@
+"""Unbounded reads and messages (issue 27, items 8 and 11): load_scene('/dev/zero') grew
+to 12 GB, a list of 10^7 elements took 28 s and 670 MB before it was refused, a 100 MB
+unknown key was echoed whole in the error, a key with an embedded NUL cut the message
+short, and JSON text starting with a byte order mark was taken for a path."""
+
+from __future__ import annotations
+
+import json
+import os
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import airlight
+
+BASE = {"film": {"width": 4, "height": 3},
+        "camera": {"position": [0, 1.7, 0], "look_at": [0, 1.7, -10], "up": [0, 1, 0], "fov_y": 60}}
+
+
+@pytest.mark.skipif(not os.path.exists("/dev/zero"), reason="no /dev/zero")
+def test_an_endless_file_is_refused_after_64_mib():
+    with pytest.raises(ValueError, match=r"^scene file /dev/zero is larger than 64 MiB$"):
+        airlight.load_scene("/dev/zero")
+
+
+def test_a_huge_file_is_refused_by_python_and_by_the_demo(tmp_path):
+    big = tmp_path / "big.json"
+    with open(big, "wb") as f:
+        f.truncate((64 << 20) + 1)
+    with pytest.raises(ValueError, match="larger than 64 MiB"):
+        airlight.load_scene(big)
+    demo = Path(sys.executable).with_name("airlight-demo")
+    if not demo.exists():
+        pytest.skip(f"{demo} is not installed")
+    done = subprocess.run([str(demo), "--scene", str(big), "--out", str(tmp_path / "x.png")],
+                          capture_output=True, text=True, timeout=60)
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"airlight-demo: scene file {big} is larger than 64 MiB", done.stderr
+
+
+def test_a_list_of_ten_million_elements_is_refused_before_conversion():
+    scene = dict(BASE, lights=[0] * 10_000_000)
+    with pytest.raises(ValueError, match=r"^lights: list too long \(10000000 elements, at most 1048576\)$"):
+        airlight.load_scene(scene)
+
+
+def test_a_huge_unknown_key_is_not_echoed_whole():
+    scene = dict(BASE, **{"x" * 10_000_000: 1})
+    with pytest.raises(ValueError) as info:
+        airlight.load_scene(scene)
+    message = str(info.value)
+    assert len(message) < 1000 and "more bytes" in message, message[:300]
+
+
+def test_a_key_with_an_embedded_nul_is_named_whole():
+    scene = dict(BASE, **{"bad\x00key": 1})
+    with pytest.raises(ValueError) as info:
+        airlight.load_scene(scene)
+    assert "bad\\x00key" in str(info.value)
+
+
+def test_json_text_with_a_byte_order_mark_is_json(tmp_path):
+    text = "\ufeff" + json.dumps(BASE)
+    assert airlight.load_scene(text)["film"]["width"] == 4
+    path = tmp_path / "bom.json"
+    path.write_bytes(text.encode("utf-8"))
+    assert airlight.load_scene(path)["film"]["width"] == 4
