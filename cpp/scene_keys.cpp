@@ -59,7 +59,11 @@ void fail(Kind kind, const std::string& field, const std::string& message) {
     throw SceneError(kind, printable(field), printable(message));
 }
 
-std::string join_path(const std::string& path, const std::string& key) { return path.empty() ? key : path + "." + key; }
+// An empty key (valid JSON) is shown as "" so that the path still names it.
+std::string join_path(const std::string& path, const std::string& key) {
+    const std::string shown = key.empty() ? std::string("\"\"") : key;
+    return path.empty() ? shown : path + "." + shown;
+}
 
 std::string index_path(const std::string& path, std::size_t i) { return path + "[" + std::to_string(i) + "]"; }
 
@@ -153,7 +157,9 @@ float read_positive(const Value& v, double hi, bool hi_inclusive) {
     float f = static_cast<float>(x);
     if (!(x > 0 && f > 0)) fail(Kind::value, v.field, "must be > 0");
     if (!std::isfinite(f)) fail(Kind::value, v.field, "out of range for a 32-bit float");
-    bool ok = hi_inclusive ? (x <= hi && f <= hi) : (x < hi && f < hi);
+    // The bound holds for the float value too, compared with the bound's own float (float(1e30) > 1e30).
+    const float hi_f = static_cast<float>(hi);
+    bool ok = hi_inclusive ? (x <= hi && f <= hi_f) : (x < hi && f < hi_f);
     if (!ok) fail(Kind::value, v.field, std::string(hi_inclusive ? "must be <= " : "must be < ") + format_number(hi));
     return f;
 }

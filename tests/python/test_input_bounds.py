@@ -67,3 +67,20 @@ def test_json_text_with_a_byte_order_mark_is_json(tmp_path):
     path = tmp_path / "bom.json"
     path.write_bytes(text.encode("utf-8"))
     assert airlight.load_scene(path)["film"]["width"] == 4
+
+
+def test_an_empty_key_is_named_in_the_message():
+    """Fuzz finding bad-input-empty-key: '' gave 'camera.: unknown key' (no field)."""
+    scene = {**BASE, "camera": {**BASE["camera"], "": 1}}
+    with pytest.raises(ValueError, match=r'^camera\."": unknown key'):
+        airlight.load_scene(scene)
+    with pytest.raises(ValueError, match=r'^"": unknown key'):
+        airlight.load_scene({**BASE, "": 1})
+
+
+def test_display_white_takes_its_documented_bound_itself():
+    """Fuzz finding display-white-1e30-refused: float32(1e30) > 1e30 refused the bound itself."""
+    loaded = airlight.load_scene({**BASE, "display": {"white": 1e30}})
+    assert loaded["display"]["white"] == pytest.approx(1e30)
+    with pytest.raises(ValueError, match=r"^display\.white: must be <= 1e\+30$"):
+        airlight.load_scene({**BASE, "display": {"white": 2e30}})
