@@ -4,6 +4,7 @@ from __future__ import annotations
 
 import argparse
 import sys
+import time
 from pathlib import Path
 
 from . import harness
@@ -16,11 +17,16 @@ def _parser() -> argparse.ArgumentParser:
         description="Renders random valid scenes on each backend (in a worker process, with a timeout) and "
                     "validates random bad inputs; shrinks every distinct failure to a minimal scene file.")
     p.add_argument("--scenes", type=int, default=100, help="valid scenes to render (default 100)")
-    p.add_argument("--bad-inputs", type=int, default=0, help="mutated (invalid) scenes to validate (default 0)")
+    p.add_argument("--bad-inputs", type=int, default=0,
+                   help="mutated (invalid) scenes to validate (default 0)")
     p.add_argument("--seed", type=int, default=0, help="the run's seed: the same seed, the same scenes")
     p.add_argument("--backends", default="gl,cpu",
                    help="comma-separated: gl, cpu (both: also compared); with --demo: demo (default gl,cpu)")
-    p.add_argument("--timeout", type=float, default=60.0, help="seconds a render may take before it is a hang")
+    p.add_argument("--duration", type=float, default=None,
+                   help="stop starting valid scenes after this many seconds (the bad inputs get 120 s more)")
+    p.add_argument("--timeout", type=float, default=180.0,
+                   help="seconds a render may take before it is a hang (default 180: a cold GL shader "
+                        "variant compiles in 5-25 s on llvmpipe)")
     p.add_argument("--out", type=Path, default=Path("fuzz-out"), help="directory for findings and the report")
     p.add_argument("--film", default="48x32", help="largest film WxH (corner films aside; default 48x32)")
     p.add_argument("--fixed-film", default=None, help="every film WxH (e.g. 8x6)")
@@ -54,7 +60,8 @@ def main(argv: list[str] | None = None) -> int:
     backends = tuple(b for b in args.backends.split(",") if b)
     allowed = {"demo"} if args.demo else {"gl", "cpu"}
     if not backends or not set(backends) <= allowed:
-        print(f"--backends: must be a comma-separated subset of {', '.join(sorted(allowed))}", file=sys.stderr)
+        print(f"--backends: must be a comma-separated subset of {', '.join(sorted(allowed))}",
+              file=sys.stderr)
         return 2
     exclude = frozenset(x for x in args.exclude.split(",") if x)
     unknown = exclude - set(REGIONS)
@@ -68,14 +75,16 @@ def main(argv: list[str] | None = None) -> int:
     options = harness.FuzzOptions(scenes=args.scenes, seed=args.seed, backends=backends, timeout=args.timeout,
                                   out=args.out, bad_inputs=args.bad_inputs, display=not args.no_display,
                                   shrink_seconds=args.shrink_seconds, generator=config, demo=args.demo,
-                                  fresh=args.fresh, progress=not args.quiet, tolerance=args.tolerance)
+                                  fresh=args.fresh, progress=not args.quiet, tolerance=args.tolerance,
+                                  deadline=time.monotonic() + args.duration if args.duration else None)
     if args.calibrate:
         return harness.calibrate(options)
     if args.replay:
         return harness.replay(args.replay, options)
     if args.replay_bad:
         return harness.replay_bad(args.replay_bad, options)
-    print(f"airlight fuzz: seed {args.seed}, backends {','.join(backends)} (here: {harness.environment_note()}), "
+    print(f"airlight fuzz: seed {args.seed}, backends {','.join(backends)} "
+          f"(here: {harness.environment_note()}), "
           f"out {args.out}", file=sys.stderr)
     report = harness.run(options)
     print(harness.summary(report))

@@ -60,7 +60,8 @@ def image_problems(image: np.ndarray, width: int, height: int) -> list[tuple[str
     negative = finite & (image < 0)
     if negative.any():
         rows, cols = np.nonzero(negative.any(axis=2))
-        problems.append(("negative", f"{int(negative.sum())} negative values (least {float(image[negative].min()):.3g}), "
+        least = float(image[negative].min())
+        problems.append(("negative", f"{int(negative.sum())} negative values (least {least:.3g}), "
                                      f"first at row {rows[0]}, column {cols[0]}"))
     return problems
 

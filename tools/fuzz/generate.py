@@ -34,6 +34,7 @@ REGIONS = {
     "display": "the display object",
     "spot": "spot lights",
     "extreme_phase": "|g| within 1e-3 of 1",
+    "empty_key": 'bad inputs: the unknown key "" (an empty string)',
 }
 
 
@@ -192,7 +193,8 @@ def _surface(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
         surface["normal"] = d.direction()
     elif kind == "box":
         lo = d.point(centre, scale)
-        size = [d.value(lambda: d.log_uniform(1e-2, 3.0) * scale, [1e-3, 1e3, 1e-4 * scale]) for _ in range(3)]
+        size = [d.value(lambda: d.log_uniform(1e-2, 3.0) * scale, [1e-3, 1e3, 1e-4 * scale])
+                for _ in range(3)]
         hi = [_clamp_coord(a + s) for a, s in zip(lo, size)]
         lo = [min(a, b - max(abs(b) * 1e-6, 1e-3)) for a, b in zip(lo, hi)]  # min < max in float32 too
         surface["min"], surface["max"] = lo, hi
@@ -258,7 +260,8 @@ def _quality(d: _Draw) -> dict[str, Any] | None:
     if d.chance(0.3):
         q["rainbow_wavelengths"] = d.choice([3, 5, 9, 17, 33])
     if d.chance(0.3):
-        q["sun_shadow_map"] = d.choice([0, 16, 17, 64, 256, 1024, 4096]) if d.corner() else d.rng.randint(16, 512)
+        corners = [0, 16, 17, 64, 256, 1024, 4096]
+        q["sun_shadow_map"] = d.choice(corners) if d.corner() else d.rng.randint(16, 512)
     return q
 
 
@@ -278,7 +281,8 @@ def _display(d: _Draw) -> dict[str, Any] | None:
     if d.chance(0.4):
         glare: dict[str, Any] = {}
         if d.chance(0.7):
-            glare["pupil_diameter"] = "auto" if d.chance(0.3) else d.value(lambda: d.rng.uniform(1, 9), [1.0, 9.0])
+            glare["pupil_diameter"] = ("auto" if d.chance(0.3)
+                                       else d.value(lambda: d.rng.uniform(1, 9), [1.0, 9.0]))
         if d.chance(0.5):
             glare["eyelashes"] = d.chance(0.5)
         out["glare"] = glare
@@ -299,7 +303,8 @@ def _daytime(d: _Draw, scene: Scene) -> None:
     if needs_sun or d.chance(0.6):
         sun: dict[str, Any] = {}
         if d.chance(0.8):
-            sun["elevation"] = d.value(lambda: d.rng.uniform(-10.0, 90.0), [-90.0, 90.0, 0.0, 1e-6, -1e-6, 89.9999])
+            sun["elevation"] = d.value(lambda: d.rng.uniform(-10.0, 90.0),
+                                       [-90.0, 90.0, 0.0, 1e-6, -1e-6, 89.9999])
             sun["azimuth"] = d.value(lambda: d.rng.uniform(-180.0, 360.0), [0.0, 1e6, -720.0])
         else:
             sun["direction"] = d.direction()
@@ -366,10 +371,10 @@ def _special_placements(d: _Draw, scene: Scene) -> None:
         _fix_look_at(d, cam)
     if d.chance(0.1):  # grazing: the camera on a plane, looking along it
         normal = d.unit()
-        surfaces.append({"type": "plane", "point": list(cam["position"]), "normal": normal})
+        surfaces.append({"type": "plane", "point": list(cam["position"]), "normal": list(normal)})
         tangent = _perpendicular(normal)
         cam["look_at"] = [p + _reach(cam["position"]) * t for p, t in zip(cam["position"], tangent)]
-        cam["up"] = normal
+        cam["up"] = list(normal)  # a copy: no two places of a scene share a list
         scene["surfaces"] = surfaces
 
 

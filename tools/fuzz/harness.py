@@ -39,7 +39,8 @@ from .shrink import shrink
 from .worker import Outcome, Worker
 
 Scene = dict[str, Any]
-SANITIZER_MARKS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:", "SUMMARY: UndefinedBehavior")
+SANITIZER_MARKS = ("ERROR: AddressSanitizer", "ERROR: LeakSanitizer", "runtime error:",
+                   "SUMMARY: UndefinedBehavior")
 
 
 @dataclass
@@ -80,7 +81,7 @@ class FuzzOptions:
     scenes: int = 100
     seed: int = 0
     backends: tuple[str, ...] = ("gl", "cpu")
-    timeout: float = 60.0
+    timeout: float = 180.0
     out: Path = Path("fuzz-out")
     bad_inputs: int = 0
     display: bool = True
@@ -90,6 +91,8 @@ class FuzzOptions:
     fresh: bool = False
     progress: bool = True
     tolerance: float = compare.TOLERANCE
+    deadline: float | None = None  # time.monotonic() after which no new valid scene is started
+    bad_input_grace: float = 120.0  # seconds after the deadline the bad inputs may still take
 
 
 @dataclass
@@ -114,7 +117,8 @@ class RunReport:
 
 
 class Progress:
-    """A one-line progress bar on stderr (a line per 10 % when stderr is not a terminal)."""
+    """A one-line progress bar on stderr (when stderr is not a terminal: a line per 5 %, and at
+    least one a minute)."""
 
     def __init__(self, total: int, label: str, enabled: bool = True) -> None:
         self.total = max(total, 1)
@@ -122,7 +126,8 @@ class Progress:
         self.enabled = enabled
         self.start = time.monotonic()
         self.tty = sys.stderr.isatty()
-        self._last_decile = -1
+        self._last_step = -1
+        self._next = 0.0
 
     def update(self, done: int, note: str = "") -> None:
         """Shows ``done`` of the total, with the rate, the time left and ``note``."""
@@ -139,9 +144,12 @@ class Progress:
         if self.tty:
             sys.stderr.write("\r" + line[:150].ljust(150))
             sys.stderr.flush()
-        elif done * 10 // self.total != self._last_decile or done == self.total:
-            self._last_decile = done * 10 // self.total
+        elif (done * 20 // self.total != self._last_step or done == self.total
+              or time.monotonic() > self._next):
+            self._last_step = done * 20 // self.total
+            self._next = time.monotonic() + 60.0
             sys.stderr.write(line + "\n")
+            sys.stderr.flush()
 
     def message(self, text: str) -> None:
         """A line of its own above the bar."""
@@ -168,14 +176,17 @@ def _demo_render(demo: str, scene: Scene, timeout: float, out_png: bool) -> Outc
             run = subprocess.run([demo, "--scene", str(scene_file), "--out", str(out), "--backend", "cpu"],
                                  capture_output=True, text=True, timeout=timeout, errors="replace")
         except subprocess.TimeoutExpired:
-            return Outcome("hang", message=f"no exit within {timeout:g} s", seconds=time.perf_counter() - start)
+            return Outcome("hang", message=f"no exit within {timeout:g} s",
+                           seconds=time.perf_counter() - start)
         seconds = time.perf_counter() - start
         if any(mark in run.stderr for mark in SANITIZER_MARKS):
             return Outcome("sanitizer", message=run.stderr[-6000:], seconds=seconds)
         if run.returncode < 0:
-            return Outcome("crash", message=f"killed by signal {-run.returncode}\n{run.stderr[-4000:]}", seconds=seconds)
+            return Outcome("crash", message=f"killed by signal {-run.returncode}\n{run.stderr[-4000:]}",
+                           seconds=seconds)
         if run.returncode != 0:
-            return Outcome("exception", error_type=f"exit {run.returncode}", message=run.stderr.strip()[-2000:],
+            return Outcome("exception", error_type=f"exit {run.returncode}",
+                           message=run.stderr.strip()[-2000:],
                            seconds=seconds)
         image = None if out_png else airlight.load_pfm(out)
         return Outcome("ok", image=image, seconds=seconds)
@@ -281,8 +292,8 @@ class Recorder:
             scene_file.write_text(json.dumps(minimal, indent=1) + "\n")
             original_file.write_text(json.dumps(original, indent=1) + "\n")
             command = replay_command(scene_file, backends, demo)
-        finding = Finding(fid, problem.kind, problem.backend, problem.detail[:2000], 1, index, str(scene_file),
-                          str(original_file), command, attempts, minimal_detail[:2000])
+        finding = Finding(fid, problem.kind, problem.backend, problem.detail[:2000], 1, index,
+                          str(scene_file), str(original_file), command, attempts, minimal_detail[:2000])
         self.findings.append(finding)
         self.by_signature[problem.signature()] = finding
         self.write_index()
@@ -298,7 +309,8 @@ class Recorder:
                       f"(first: scene {f.first_scene_index})",
                       f"- minimal reproducer: `{f.scene_file}` (original: `{f.original_file}`, "
                       f"{f.shrink_attempts} shrinking tries)",
-                      f"- replay: `{f.command}`", "", "```", (f.minimal_detail or f.detail).strip()[:1500], "```", ""]
+                      f"- replay: `{f.command}`", "", "```", (f.minimal_detail or f.detail).strip()[:1500],
+                      "```", ""]
         (self.out / "findings.md").write_text("\n".join(lines))
 
 
@@ -311,7 +323,8 @@ def _write_bad_input(scene_file: Path, original_file: Path, minimal: Mutation, o
         return f".venv/bin/python -m tools.fuzz --replay-bad {scene_file}"
     except (TypeError, ValueError):
         py_file = scene_file.with_suffix(".py")
-        py_file.write_text(f"# mutated at {format_path(minimal.path)}: {minimal.what}\nscene = {minimal.scene!r}\n")
+        py_file.write_text(f"# mutated at {format_path(minimal.path)}: {minimal.what}\n"
+                           f"scene = {minimal.scene!r}\n")
         original_file.write_text(json.dumps(original, indent=1) + "\n")
         return (f".venv/bin/python -c \"import airlight; exec(open('{py_file}').read()); "
                 f"airlight.load_scene(scene)\"")
@@ -350,6 +363,9 @@ def run_valid(options: FuzzOptions, worker: Worker | None, recorder: Recorder, r
               progress: Progress) -> None:
     """The valid-scene part of a run."""
     for index in range(options.scenes):
+        if options.deadline is not None and time.monotonic() > options.deadline:
+            progress.message(f"time is up after {index} scenes")
+            break
         scene = random_scene(scene_rng(options.seed, index), options.generator)
         problems = check_scene(worker, scene, options.backends, options, report)
         report.scenes += 1
@@ -363,8 +379,10 @@ def run_valid(options: FuzzOptions, worker: Worker | None, recorder: Recorder, r
             progress.message(f"scene {index}: {problem.kind} on {problem.backend}: "
                              f"{problem.detail.splitlines()[0][:200] if problem.detail else ''}")
             predicate = _still_fails(worker, problem, options)
-            minimal, attempts = shrink(scene, predicate, budget_seconds=options.shrink_seconds,
-                                       progress=lambda text, i=index: progress.update(i, text))
+            def note(text: str, at: int = index) -> None:
+                progress.update(at, text)
+
+            minimal, attempts = shrink(scene, predicate, budget_seconds=options.shrink_seconds, progress=note)
             backends = ("gl", "cpu") if problem.kind == "disagreement" else (problem.backend,)
             minimal_problems = (check_scene(worker, minimal, backends, options)
                                 if problem.kind != "invalid" else [problem])
@@ -380,7 +398,8 @@ def _bad_outcome(worker: Worker | None, mutation: Mutation, options: FuzzOptions
         return _judge_demo(options.demo, mutation, options.timeout)
     assert worker is not None
     outcome = worker.request("validate", mutation.scene, timeout=min(options.timeout, 30.0))
-    return judge(outcome.status, outcome.error_type, outcome.message, mutation)
+    verdict = judge(outcome.status, outcome.error_type, outcome.message, mutation)
+    return "accepted" if verdict is None and outcome.status == "ok" else verdict
 
 
 def _judge_demo(demo: str, mutation: Mutation, timeout: float) -> str | None:
@@ -401,7 +420,7 @@ def _judge_demo(demo: str, mutation: Mutation, timeout: float) -> str | None:
     if any(mark in run.stderr for mark in SANITIZER_MARKS):
         return "sanitizer: " + run.stderr[-3000:]
     if run.returncode == 0:
-        return None
+        return "accepted"
     lines = run.stderr.strip().splitlines()
     if run.returncode != 2 or len(lines) != 1:
         return f"exit status {run.returncode} with stderr {run.stderr.strip()[:500]!r}"
@@ -412,12 +431,16 @@ def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, rep
             progress: Progress) -> None:
     """The bad-input part of a run: mutations of valid scenes must be refused cleanly."""
     for index in range(options.bad_inputs):
+        if options.deadline is not None and time.monotonic() > options.deadline + options.bad_input_grace:
+            progress.message(f"time is up after {index} bad inputs")
+            break
         rng = scene_rng(options.seed, 10_000_000 + index)
         base = random_scene(rng, options.generator)
-        mutation = mutate(base, rng)
+        mutation = mutate(base, rng, empty_key=options.generator.allows("empty_key"))
         verdict = _bad_outcome(worker, mutation, options)
         report.bad_inputs += 1
-        if verdict is None:
+        report.bad_inputs_accepted += verdict == "accepted"
+        if verdict in (None, "accepted"):
             progress.update(index + 1, f"{len(recorder.findings)} findings")
             continue
         kind = verdict.split(":")[0].split(" ")[0]
@@ -428,7 +451,8 @@ def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, rep
             known.occurrences += 1
         else:
             progress.message(f"bad input {index}: {verdict[:200]}")
-            recorder.add(problem, index, base, mutation, 0, verdict, ("loader",), options.demo, bad_input=True)
+            recorder.add(problem, index, base, mutation, 0, verdict, ("loader",), options.demo,
+                         bad_input=True)
         progress.update(index + 1, f"{len(recorder.findings)} findings")
 
 
@@ -438,7 +462,8 @@ def run(options: FuzzOptions) -> RunReport:
     report = RunReport(backends=options.backends)
     recorder = Recorder(options.out)
     start = time.monotonic()
-    worker = None if options.demo else Worker(options.out / "logs", timeout=options.timeout, fresh=options.fresh)
+    worker = (None if options.demo
+              else Worker(options.out / "logs", timeout=options.timeout, fresh=options.fresh))
     try:
         if options.scenes:
             progress = Progress(options.scenes, "scenes", options.progress)
@@ -532,7 +557,8 @@ def summary(report: RunReport) -> str:
     """The run's figures as text."""
     counts = Counter(report.problems)
     lines = [f"{report.scenes} valid scenes ({report.renders} renders on {', '.join(report.backends)}), "
-             f"{report.bad_inputs} bad inputs, {report.seconds:.0f} s; worker restarts {report.worker_restarts}; "
+             f"{report.bad_inputs} bad inputs ({report.bad_inputs_accepted} still valid), "
+             f"{report.seconds:.0f} s; worker restarts {report.worker_restarts}; "
              f"largest GL/CPU disagreement {report.max_disagreement:.2e}; "
              f"{report.cpu_fallback_frames} GL frames with loop-limit CPU fallback pixels",
              f"problems: {dict(counts) if counts else 'none'}",

@@ -89,11 +89,13 @@ def _json_kind(value: Any) -> str:
 def _bad_number(value: Any, rng: random.Random) -> Any:
     return rng.choice([-1.0, -1e-300, -1e300, 1e300, 1e39, -1e39, math.nan, math.inf, -math.inf, 2 ** 70,
                        -(2 ** 70), 0.5, 0, 16385, 1e7 + 1, 180.0, 90.000001, 1.0000001, -0.0,
-                       (value * 1e30 if isinstance(value, (int, float)) and not isinstance(value, bool) else 1e30)])
+                       (value * 1e30 if isinstance(value, (int, float)) and not isinstance(value, bool)
+                        else 1e30)])
 
 
-def mutate(scene: dict[str, Any], rng: random.Random) -> Mutation:
-    """One random mutation of a copy of ``scene`` (see the module docstring)."""
+def mutate(scene: dict[str, Any], rng: random.Random, *, empty_key: bool = True) -> Mutation:
+    """One random mutation of a copy of ``scene`` (see the module docstring). ``empty_key=False``
+    leaves out the unknown key ``""`` (finding bad-input-empty-key: its message has no field path)."""
     bad = copy.deepcopy(scene)
     places = _places(bad)
     path = rng.choice(places)
@@ -125,7 +127,8 @@ def mutate(scene: dict[str, Any], rng: random.Random) -> Mutation:
             obj[typo] = obj.pop(name) if rng.random() < 0.5 else 1.0
             new = typo
         else:
-            new = rng.choice(["colour", "intensities", "Type", "", "sigma_s", "x" * 300])
+            names = ["colour", "intensities", "Type", "sigma_s", "x" * 300] + ([""] if empty_key else [])
+            new = rng.choice(names)
             obj[new] = 1.0
         path = (*obj_path, new)
         what = f"unknown key {new!r}"
@@ -145,7 +148,7 @@ def mutate(scene: dict[str, Any], rng: random.Random) -> Mutation:
         what = f"list {parent[key]!r}"
     elif kind == "deep":
         nested: Any = 1.0
-        for _ in range(rng.choice([70, 500])):
+        for _ in range(rng.choice([70, 200])):  # deeper cannot be pickled to the worker
             nested = [nested]
         parent[key] = nested
         what = "deeply nested list"
@@ -177,9 +180,9 @@ def related(error_path: Path, mutated: Path) -> bool:
         return True
     if len(error_path) == len(mutated) and error_path[:-1] == mutated[:-1]:  # a sibling
         return True
-    if error_path[:len(mutated) - 1] == mutated[:-1] and len(mutated) > 1:  # inside a sibling
-        return True
-    return error_path[:1] and tuple(mutated[:1]) in _CROSS_FIELDS and error_path[0] in _CROSS_FIELDS[mutated[:1]]
+    if len(error_path) >= 2 and mutated[:len(error_path) - 1] == error_path[:-1]:
+        return True  # a sibling of an object around it: surfaces[1].max for surfaces[1].min[0]
+    return bool(error_path) and mutated[:1] in _CROSS_FIELDS and error_path[0] in _CROSS_FIELDS[mutated[:1]]
 
 
 def judge(status: str, error_type: str, message: str, mutation: Mutation) -> str | None:

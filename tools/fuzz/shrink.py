@@ -99,7 +99,8 @@ def candidates(scene: Scene) -> Iterator[Scene]:
             point = {k: light[k] for k in ("position", "intensity", "radius") if k in light}
             yield _replaced(scene, ("lights", i), {"type": "point", **point})
     medium = scene.get("medium")
-    if isinstance(medium, dict) and isinstance(medium.get("phase"), dict) and medium["phase"].get("type") != "isotropic":
+    phase = medium.get("phase") if isinstance(medium, dict) else None
+    if isinstance(phase, dict) and phase.get("type") != "isotropic":
         yield _replaced(scene, ("medium", "phase"), {"type": "isotropic"})
     film = scene.get("film")
     if isinstance(film, dict):
@@ -110,7 +111,8 @@ def candidates(scene: Scene) -> Iterator[Scene]:
                     yield _replaced(scene, ("film",), {"width": size[0], "height": size[1]})
     for path, obj in list(_objects(scene)):
         for key, value in obj.items():
-            if isinstance(value, list) and len(value) == 3 and all(isinstance(x, (int, float)) for x in value):
+            triple = isinstance(value, list) and len(value) == 3
+            if triple and all(isinstance(x, (int, float)) for x in value):
                 yield _replaced(scene, (*path, key), value[0])
                 yield _replaced(scene, (*path, key), max(value))
     for path, x in list(_numbers(scene)):
@@ -121,8 +123,8 @@ def candidates(scene: Scene) -> Iterator[Scene]:
         for s in simpler:
             if s != x and s not in tried and _size(s) < _size(x):
                 tried.add(s)
-                value: Any = int(s) if isinstance(_get(scene, path), int) and s == int(s) else s
-                yield _replaced(scene, path, value)
+                number: Any = int(s) if isinstance(_get(scene, path), int) and s == int(s) else s
+                yield _replaced(scene, path, number)
 
 
 def _size(x: float) -> tuple[int, float]:

@@ -154,7 +154,8 @@ class Worker:
             ready = self._conn.poll(limit)
             if not ready:
                 self._kill()
-                return Outcome("hang", message=f"no answer within {limit:g} s", seconds=time.perf_counter() - start)
+                return Outcome("hang", message=f"no answer within {limit:g} s",
+                               seconds=time.perf_counter() - start)
             status, image, shown, error_type, message, seconds, fallback = self._conn.recv()
         except (EOFError, BrokenPipeError, ConnectionResetError, OSError):
             proc = self._proc
