@@ -131,6 +131,9 @@ def test_loader_message_naming_another_field_is_a_finding(tmp_path: Path,
     assert [f.kind for f in report.findings] == ["bad-input-valueerror"]
     assert report.findings[0].occurrences == 3
     assert "film.width" in report.findings[0].detail
+    # Shrunk: the loader reads the film first, so nothing but the required keys is left.
+    reproducer = json.loads(Path(report.findings[0].scene_file).read_text())
+    assert set(reproducer["scene"]) == {"film", "camera"} and reproducer["mutated_path"] == "camera.fov_y"
 
 
 def test_bad_inputs_are_refused_with_the_field_path_in_process() -> None:

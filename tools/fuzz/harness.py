@@ -427,6 +427,11 @@ def _judge_demo(demo: str, mutation: Mutation, timeout: float) -> str | None:
     return None
 
 
+def _verdict_kind(verdict: str) -> str:
+    """The first word of a bad-input verdict: the exception type, crash, hang, sanitizer, exit."""
+    return verdict.split(":")[0].split(" ")[0]
+
+
 def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, report: RunReport,
             progress: Progress) -> None:
     """The bad-input part of a run: mutations of valid scenes must be refused cleanly."""
@@ -443,7 +448,7 @@ def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, rep
         if verdict in (None, "accepted"):
             progress.update(index + 1, f"{len(recorder.findings)} findings")
             continue
-        kind = verdict.split(":")[0].split(" ")[0]
+        kind = _verdict_kind(verdict)
         problem = Problem(f"bad-input-{_slug(kind)}", "loader", verdict, error_type=_slug(mutation.what)[:20])
         report.problems[problem.kind] = report.problems.get(problem.kind, 0) + 1
         known = recorder.seen(problem)
@@ -451,7 +456,16 @@ def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, rep
             known.occurrences += 1
         else:
             progress.message(f"bad input {index}: {verdict[:200]}")
-            recorder.add(problem, index, base, mutation, 0, verdict, ("loader",), options.demo,
+
+            def same_verdict(candidate: Scene, m: Mutation = mutation, kind: str = kind) -> bool:
+                v = _bad_outcome(worker, Mutation(candidate, m.path, m.what), options)
+                return v not in (None, "accepted") and _verdict_kind(v) == kind
+
+            scene, attempts = shrink(mutation.scene, same_verdict,
+                                     budget_seconds=min(options.shrink_seconds, 60.0))
+            minimal = Mutation(scene, mutation.path, mutation.what)
+            detail = _bad_outcome(worker, minimal, options) or verdict
+            recorder.add(problem, index, base, minimal, attempts, detail, ("loader",), options.demo,
                          bad_input=True)
         progress.update(index + 1, f"{len(recorder.findings)} findings")
 
