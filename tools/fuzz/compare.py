@@ -4,9 +4,12 @@ The disagreement metric. Both backends run the same GLSL in float32, so they dif
 rounding, except where a rounding decides a discrete event: a ray that grazes an edge hits
 a surface on one backend and misses it on the other. Per pixel and channel,
 
-    e = |gl - cpu| / (max(gl, cpu) + floor),   floor = FLOOR_FRACTION x (the image's largest value),
+    e = |gl - cpu| / (max(gl, cpu) + floor),   floor = max(FLOOR_FRACTION x (the image's largest
+                                                           value), ABSOLUTE_FLOOR),
 
-so pixels far below the image's maximum (relative to it) do not count, and a pixel is *bad*
+so pixels far below the image's maximum (relative to it) do not count, nor radiances below
+ABSOLUTE_FLOOR (1e-30: llvmpipe flushes float32 subnormals, below 1.2e-38, to zero where the CPU
+keeps them; the first long run's only "disagreement" was 0 against 4e-45), and a pixel is *bad*
 when its largest e exceeds the tolerance. A bad pixel is *excused* when it is a single-pixel
 edge difference: none of its 8 neighbours is bad and it lies on a discontinuity of the CPU
 or the GL image (a neighbour differs from it by more than EDGE_JUMP in the same measure).
@@ -21,6 +24,7 @@ from dataclasses import dataclass
 import numpy as np
 
 FLOOR_FRACTION = 1e-3
+ABSOLUTE_FLOOR = 1e-30
 TOLERANCE = 1e-2
 EDGE_JUMP = 0.2
 
@@ -107,7 +111,7 @@ def disagreement(gl: np.ndarray, cpu: np.ndarray, tolerance: float = TOLERANCE) 
     top = float(max(a.max(initial=0.0), b.max(initial=0.0)))
     if top == 0.0:
         return Disagreement(False, 0.0, 0.0, 0, 0, None)
-    floor = FLOOR_FRACTION * top
+    floor = max(FLOOR_FRACTION * top, ABSOLUTE_FLOOR)
     e = _relative(a, b, floor)
     bad = e > tolerance
     isolated = _neighbour_max(bad.astype(np.uint8)) == 0

@@ -72,6 +72,8 @@ class Finding:
     command: str
     shrink_attempts: int = 0
     minimal_detail: str = ""
+    signature: list[str] = field(default_factory=list)
+    features: list[str] = field(default_factory=list)
 
 
 @dataclass
@@ -254,6 +256,27 @@ def check_scene(worker: Worker | None, scene: Scene, backends: tuple[str, ...], 
 # --- findings ------------------------------------------------------------------------
 
 
+def features(scene: Any) -> set[str]:
+    """What a scene is made of, coarsely: its top-level keys (not null), light and surface
+    types, the medium's phase type, quality keys, sky model and atmosphere species."""
+    out: set[str] = set()
+    if not isinstance(scene, dict):
+        return out
+    for key, value in scene.items():
+        if value is None:
+            continue
+        out.add(str(key))
+        if key in ("lights", "surfaces") and isinstance(value, list):
+            out.update(f"{key}:{x.get('type')}" for x in value if isinstance(x, dict))
+        elif isinstance(value, dict) and key in ("quality", "atmosphere", "display"):
+            out.update(f"{key}.{k}" for k, v in value.items() if v is not None)
+        elif key == "medium" and isinstance(value, dict) and isinstance(value.get("phase"), dict):
+            out.add(f"phase:{value['phase'].get('type')}")
+        elif key == "sky" and isinstance(value, dict):
+            out.add(f"sky:{value.get('model')}")
+    return out
+
+
 def _slug(text: str) -> str:
     return re.sub(r"[^a-z0-9]+", "-", text.lower()).strip("-")[:40]
 
@@ -272,11 +295,17 @@ class Recorder:
         self.dir = out / "findings"
         self.dir.mkdir(parents=True, exist_ok=True)
         self.findings: list[Finding] = []
-        self.by_signature: dict[tuple[str, str, str], Finding] = {}
 
-    def seen(self, problem: Problem) -> Finding | None:
-        """The finding already recorded for this problem's signature, if any."""
-        return self.by_signature.get(problem.signature())
+    def seen(self, problem: Problem, scene: Any = None) -> Finding | None:
+        """The finding already recorded for this problem: the same signature and, for a valid
+        scene, a minimal reproducer whose features (:func:`features`) the scene all has (a scene
+        of other features with the same kind of problem may be another bug: it is shrunk anew)."""
+        for finding in self.findings:
+            if finding.signature != list(problem.signature()):
+                continue
+            if scene is None or set(finding.features) <= features(scene):
+                return finding
+        return None
 
     def add(self, problem: Problem, index: int, original: Any, minimal: Any, attempts: int,
             minimal_detail: str, backends: tuple[str, ...], demo: str | None, bad_input: bool) -> Finding:
@@ -293,9 +322,10 @@ class Recorder:
             original_file.write_text(json.dumps(original, indent=1) + "\n")
             command = replay_command(scene_file, backends, demo)
         finding = Finding(fid, problem.kind, problem.backend, problem.detail[:2000], 1, index,
-                          str(scene_file), str(original_file), command, attempts, minimal_detail[:2000])
+                          str(scene_file), str(original_file), command, attempts, minimal_detail[:2000],
+                          list(problem.signature()),
+                          sorted(features(minimal)) if not bad_input else [])
         self.findings.append(finding)
-        self.by_signature[problem.signature()] = finding
         self.write_index()
         return finding
 
@@ -371,7 +401,7 @@ def run_valid(options: FuzzOptions, worker: Worker | None, recorder: Recorder, r
         report.scenes += 1
         for problem in problems:
             report.problems[problem.kind] = report.problems.get(problem.kind, 0) + 1
-            known = recorder.seen(problem)
+            known = recorder.seen(problem, scene)
             if known is not None:
                 known.occurrences += 1
                 recorder.write_index()
