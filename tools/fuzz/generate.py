@@ -157,7 +157,7 @@ def _medium(d: _Draw) -> dict[str, Any] | None:
         return None
     corners = [0.0, 1e-9, 1e-4, 2.0]
     if d.config.allows("huge_medium"):
-        corners += [50.0, 1e3, 1e6]
+        corners += [50.0, 1e3]  # 1e3: the bound (max_extinction)
     medium: dict[str, Any] = {"sigma_t": d.rgb(lambda: d.log_uniform(1e-4, 0.5), corners)}
     if d.chance(0.7):
         medium["albedo"] = _albedo(d)
@@ -275,9 +275,7 @@ def _display(d: _Draw) -> dict[str, Any] | None:
     if d.chance(0.6):
         out["tonemap"] = d.choice(["loglog", "reinhard", "filmic", "linear"])
     if d.chance(0.3):
-        # The loader's bound is <= 1e30 on the float32 value (finding 001: README says only "> 0"),
-        # which 1e30 itself exceeds once rounded to float32.
-        out["white"] = d.value(lambda: d.log_uniform(0.1, 1e3), [1e-30, 1e29])
+        out["white"] = d.value(lambda: d.log_uniform(0.1, 1e3), [1e-30, 1e30])
     if d.chance(0.4):
         glare: dict[str, Any] = {}
         if d.chance(0.7):
@@ -319,7 +317,7 @@ def _daytime(d: _Draw, scene: Scene) -> None:
         if d.chance(0.6):
             aerosol: dict[str, Any] = {}
             if d.chance(0.6):
-                aerosol["visibility"] = d.value(lambda: d.log_uniform(50.0, 1e5), [1e-3, 1.0, 1e9])
+                aerosol["visibility"] = d.value(lambda: d.log_uniform(50.0, 1e5), [3.912e-3, 1.0, 1e9])
             else:
                 aerosol["coefficient"] = d.value(lambda: d.log_uniform(1e-6, 0.1), [0.0, 1e3, 10.0])
             if d.chance(0.5):
