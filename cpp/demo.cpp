@@ -2,7 +2,10 @@
 // display stage: exposure, glare, tone curve) or PFM (float radiance), or the
 // approaching-car headlight sequence (issue 8). Bad input exits non-zero with
 // a one-line message.
+#include <unistd.h>
+
 #include <atomic>
+#include <cctype>
 #include <chrono>
 #include <cmath>
 #include <csignal>
@@ -12,6 +15,7 @@
 #include <filesystem>
 #include <glm/vec3.hpp>
 #include <string>
+#include <system_error>
 #include <vector>
 
 #include "airlight/display.hpp"
@@ -67,10 +71,35 @@ struct Options {
     std::exit(2);
 }
 
+// True when `text` is a plain decimal number: [-]digits, and for a real number
+// also [.digits][e[+-]digits]; no spaces, no '+', no hex, no inf or nan (strtol
+// and strtod alone took ' 10' and '0x10').
+bool plain_decimal(const char* text, bool integer) {
+    const char* p = text;
+    if (*p == '-') ++p;
+    const char* digits = p;
+    while (std::isdigit(static_cast<unsigned char>(*p))) ++p;
+    bool any = p > digits;
+    if (!integer && *p == '.') {
+        const char* fraction = ++p;
+        while (std::isdigit(static_cast<unsigned char>(*p))) ++p;
+        any = any || p > fraction;
+    }
+    if (!any) return false;
+    if (!integer && (*p == 'e' || *p == 'E')) {
+        ++p;
+        if (*p == '+' || *p == '-') ++p;
+        const char* exponent = p;
+        while (std::isdigit(static_cast<unsigned char>(*p))) ++p;
+        if (p == exponent) return false;
+    }
+    return *p == '\0';
+}
+
 int parse_int(const std::string& flag, const char* text, int lo, int hi) {
     char* end = nullptr;
     const long value = std::strtol(text, &end, 10);
-    if (end == text || *end != '\0' || value < lo || value > hi) {
+    if (!plain_decimal(text, true) || end == text || *end != '\0' || value < lo || value > hi) {
         fail(flag + " must be an integer in " + std::to_string(lo) + ".." + std::to_string(hi) + ", got '" + text +
              "'");
     }
@@ -81,7 +110,7 @@ int parse_int(const std::string& flag, const char* text, int lo, int hi) {
 double parse_number(const std::string& flag, const char* text, double lo, double hi, const char* what) {
     char* end = nullptr;
     const double value = std::strtod(text, &end);
-    if (end == text || *end != '\0' || !(value >= lo && value <= hi)) {
+    if (!plain_decimal(text, false) || end == text || *end != '\0' || !(value >= lo && value <= hi)) {
         fail(flag + " must be " + what + ", got '" + text + "'");
     }
     return value;
@@ -304,6 +333,15 @@ int main(int argc, char** argv) {
     const Options o = parse_args(argc, argv);
     if (o.sequence.empty() && !o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm")) {
         fail("--out must end in .png or .pfm, got '" + o.out + "'");
+    }
+    if (o.sequence.empty() && !o.out.empty()) {
+        // A bad destination is reported before rendering, not after.
+        const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
+        std::error_code error;
+        if (!dir.empty() && !std::filesystem::is_directory(dir, error))
+            fail("--out: directory '" + dir.string() + "' does not exist");
+        if (access(dir.empty() ? "." : dir.c_str(), W_OK) != 0)
+            fail("--out: directory '" + (dir.empty() ? std::string(".") : dir.string()) + "' is not writable");
     }
     Scene scene;
     try {

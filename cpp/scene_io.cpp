@@ -14,6 +14,7 @@
 #include <glm/vec3.hpp>
 #include <limits>
 #include <optional>
+#include <set>
 #include <string>
 #include <utility>
 #include <vector>
@@ -387,12 +388,28 @@ std::string json_error_message(const nlohmann::json::exception& e) {
 }  // namespace
 
 Scene parse_scene(const std::string& json_text) {
+    // JSON lets an object repeat a key and the parser keeps the last one: a
+    // scene that does is refused, naming the key (a stale copy would win silently).
+    std::vector<std::set<std::string>> keys_of_open_objects;
+    std::string duplicate;
+    const auto check_keys = [&](int, json::parse_event_t event, json& parsed) {
+        if (event == json::parse_event_t::object_start) {
+            keys_of_open_objects.emplace_back();
+        } else if (event == json::parse_event_t::object_end) {
+            if (!keys_of_open_objects.empty()) keys_of_open_objects.pop_back();
+        } else if (event == json::parse_event_t::key && !keys_of_open_objects.empty()) {
+            const std::string key = parsed.get<std::string>();
+            if (!keys_of_open_objects.back().insert(key).second && duplicate.empty()) duplicate = key;
+        }
+        return true;
+    };
     json j;
     try {
-        j = json::parse(json_text);
+        j = json::parse(json_text, check_keys);
     } catch (const json::exception& e) {
         fail(Kind::value, "", json_error_message(e));
     }
+    if (!duplicate.empty()) fail(Kind::value, duplicate, "duplicate key (JSON gives each key once per object)");
     return parse_scene_json(j);
 }
 

@@ -23,6 +23,7 @@ BackendUnavailableError.__doc__ = (
 )
 
 _BACKENDS = ("auto", "gl", "cpu")
+_MAX_CPU_THREADS = 1024
 _warned_fallback = False
 
 
@@ -82,8 +83,11 @@ class Renderer:
                     warnings.warn(f"airlight: GL backend unavailable ({reason}); using the CPU backend",
                                   RuntimeWarning, stacklevel=2)
                     _warned_fallback = True
-        if not isinstance(cpu_threads, int) or cpu_threads < 0:
-            raise ValueError(f"cpu_threads: must be an integer >= 0, got {cpu_threads!r}")
+        if isinstance(cpu_threads, bool) or not isinstance(cpu_threads, int):
+            raise TypeError(f"cpu_threads: expected an integer, got {type(cpu_threads).__name__}")
+        if not 0 <= cpu_threads <= _MAX_CPU_THREADS:
+            raise ValueError(f"cpu_threads: must be in [0, {_MAX_CPU_THREADS}] (0: all cores), "
+                             f"got {cpu_threads}")
         self._native: _core.Renderer | None = _core.Renderer(backend)
         self._native.set_cpu_threads(cpu_threads)
 

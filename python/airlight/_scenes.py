@@ -4,7 +4,6 @@ directory (:func:`preset`, :func:`preset_names`)."""
 
 from __future__ import annotations
 
-import copy
 import json
 import os
 from collections.abc import Mapping
@@ -68,7 +67,13 @@ def _with_film_size(scene: SceneLike, width: int | None, height: int | None) -> 
     source = _scene_source(scene)
     if width is None and height is None:
         return source
-    data = json.loads(source) if isinstance(source, str) else copy.deepcopy(dict(source))
+    # A shallow copy: only "film" changes (a deep copy of a deeply nested dict raised RecursionError).
+    try:
+        data = json.loads(source) if isinstance(source, str) else dict(source)
+    except RecursionError:
+        raise ValueError("scene: nesting too deep") from None
+    except json.JSONDecodeError:
+        return source  # the validator names the error
     film = data.get("film")
     film = dict(film) if isinstance(film, Mapping) else {}
     given = width if height is None else height if width is None else None

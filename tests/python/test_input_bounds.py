@@ -84,3 +84,51 @@ def test_display_white_takes_its_documented_bound_itself():
     assert loaded["display"]["white"] == pytest.approx(1e30)
     with pytest.raises(ValueError, match=r"^display\.white: must be <= 1e\+30$"):
         airlight.load_scene({**BASE, "display": {"white": 2e30}})
+
+
+def test_cpu_threads_must_be_a_plain_integer_in_range():
+    with pytest.raises(TypeError, match=r"^cpu_threads: expected an integer, got bool$"):
+        airlight.Renderer("cpu", cpu_threads=True)
+    with pytest.raises(ValueError, match=r"^cpu_threads: must be in \[0, 1024\]"):
+        airlight.Renderer("cpu", cpu_threads=2**40)
+
+
+def test_a_deeply_nested_scene_with_a_film_override_is_a_value_error():
+    deep: dict = {}
+    node = deep
+    for _ in range(5000):
+        node["x"] = {}
+        node = node["x"]
+    with pytest.raises(ValueError, match="nesting too deep"):
+        airlight.render({**BASE, "extra": deep}, backend="cpu", width=4)
+
+
+def test_a_duplicate_json_key_is_refused_naming_it():
+    text = json.dumps(BASE)[:-1] + ', "film": {"width": 8, "height": 6}}'
+    with pytest.raises(ValueError, match=r"^film: duplicate key"):
+        airlight.load_scene(text)
+
+
+@pytest.mark.parametrize("args", [["--width", " 10"], ["--width", "0x10"], ["--exposure", "0x10"],
+                                  ["--exposure", "inf"], ["--height", "+12"]])
+def test_the_demo_takes_plain_decimal_numbers_only(args, tmp_path):
+    demo = Path(sys.executable).with_name("airlight-demo")
+    if not demo.exists():
+        pytest.skip(f"{demo} is not installed")
+    command = [str(demo), "--scene", "scenes/default.json", "--out", str(tmp_path / "x.png"), *args]
+    done = subprocess.run(command, capture_output=True, text=True, timeout=60,
+                          cwd=Path(__file__).resolve().parents[2])
+    assert done.returncode == 2 and f"got '{args[1]}'" in done.stderr, done.stderr
+    assert not (tmp_path / "x.png").exists()
+
+
+def test_the_demo_reports_a_bad_out_directory_before_rendering(tmp_path):
+    demo = Path(sys.executable).with_name("airlight-demo")
+    if not demo.exists():
+        pytest.skip(f"{demo} is not installed")
+    missing = tmp_path / "no" / "such"
+    done = subprocess.run([str(demo), "--scene", "scenes/default.json", "--out", str(missing / "x.png"),
+                           "--width", "8000", "--height", "8000"],
+                          capture_output=True, text=True, timeout=60, cwd=Path(__file__).resolve().parents[2])
+    assert done.returncode == 2
+    assert done.stderr.strip() == f"airlight-demo: --out: directory '{missing}' does not exist", done.stderr
