@@ -317,7 +317,7 @@ vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, vec3 or
         float d2 = dot(from_light, from_light);
         float d = sqrt(d2);
         float profile = spot ? spot_profile_toward(s, from_light / d) : 1.0f;
-        sum += profile * medium_phase(-dot(from_light, dir) / d) * exp(-sigma_t * (x + d)) / d2;
+        sum += profile * medium_phase_between(from_light / d, -dir) * exp(-sigma_t * (x + d)) / d2;
     }
     return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
 }
