@@ -23,9 +23,7 @@ from tools.fuzz.worker import Outcome, Worker
 ROOT = Path(__file__).resolve().parents[2]
 
 # Regions the short run leaves out, each for an open finding (tools/fuzz/findings/README.md);
-# re-enable a region once its finding is fixed.
-# Regions of the parameter space left out of the short run while a finding there is open
-# (tools/fuzz/findings/README.md); none now: bad-input-empty-key is fixed.
+# re-enable a region once its finding is fixed. None now: bad-input-empty-key is fixed.
 SHORT_RUN_EXCLUDE: frozenset[str] = frozenset()
 
 
