@@ -70,6 +70,8 @@ public:
     // `cancel` (optional): polled per tile; once true, throws RenderCancelled.
     void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr,
                 const std::atomic<bool>* cancel = nullptr);
+    // GL_MAX_TEXTURE_SIZE: the display stage's images must fit it on each side.
+    int max_texture_size();
     // The display stage on the GPU (see GlDisplayJob).
     void display(const GlDisplayJob& job, GlDisplayOutput& out);
     // The glare convolution of the display pass alone (FFT on the GPU, fp32, or

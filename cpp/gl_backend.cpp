@@ -445,6 +445,13 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
     if (err != GL_NO_ERROR) throw std::runtime_error("airlight: GL error " + std::to_string(err) + " while rendering");
 }
 
+int GlBackend::max_texture_size() {
+    State::Current current(*state_);
+    GLint size = 0;
+    glGetIntegerv(GL_MAX_TEXTURE_SIZE, &size);
+    return int(size);
+}
+
 // The display stage: effects/display/display_gl.cpp (GlDisplayPasses), with the context current.
 void GlBackend::display(const GlDisplayJob& job, GlDisplayOutput& out) {
     check_display_image(job.linear);

@@ -13,7 +13,8 @@ bool gl_backend_available(std::string* reason, std::string*) {
 
 GlBackend::GlBackend() { throw BackendUnavailable("airlight: GL backend unavailable: built without EGL/OpenGL"); }
 GlBackend::~GlBackend() = default;
-void GlBackend::render(const FrameData&, Image&) {}
+void GlBackend::render(const FrameData&, Image&, std::vector<size_t>*, const std::atomic<bool>*) {}
+int GlBackend::max_texture_size() { return 0; }
 void GlBackend::display(const GlDisplayJob&, GlDisplayOutput&) {}
 void GlBackend::glare_convolve(const Image&, const GlareKernel&, Image&, bool) {}
 

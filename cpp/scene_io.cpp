@@ -43,6 +43,10 @@ constexpr double max_light_radius = 1e3;
 // The largest scene file read (a scene of 10^5 lamps is about 10 MiB).
 constexpr std::size_t max_scene_file_bytes = std::size_t(64) << 20;
 constexpr double default_light_radius = 0.05;
+// The narrowest spot, in degrees (1.7 cm wide at 1 km): below, float32 cannot
+// resolve the beam's glow on surfaces (at 1e-4 degree GL's was 31 % low, the
+// CPU's 0.5 %; at 1e-3 both are within 0.3 % of the reference).
+constexpr double min_cone_angle = 1e-3;
 
 enum class LightType { point, spot };
 
@@ -167,7 +171,7 @@ PointLight parse_point_light(const SceneObject& o) {
 }
 
 // Spot light (effects/spotlights/physics.md): cone_angle is the half-angle in degrees,
-// in (0, 90] (checked on the float value too); edge in [0, 1].
+// in [min_cone_angle, 90] (checked on the float value too); edge in [0, 1].
 SpotLight parse_spot_light(const SceneObject& o) {
     o.check_keys({"type", "position", "direction", "intensity", "cone_angle", "edge", "radius"});
     SpotLight l;
@@ -177,8 +181,8 @@ SpotLight parse_spot_light(const SceneObject& o) {
     Value cone = o.req("cone_angle");
     double angle = read_number(cone);
     float angle_f = static_cast<float>(angle);
-    if (!(angle > 0 && angle_f > 0 && angle <= 90 && angle_f <= 90))
-        fail(Kind::value, cone.field, "must be in (0, 90]");
+    if (!(angle >= min_cone_angle && angle_f >= float(min_cone_angle) && angle <= 90 && angle_f <= 90))
+        fail(Kind::value, cone.field, "must be in [0.001, 90]");
     l.cone_angle_degrees = angle_f;
     if (auto v = o.opt("edge")) {
         double edge = read_number(*v);

@@ -487,6 +487,12 @@ DisplayImage run_display_stage(const Image& linear, const DisplaySettings& setti
     report.glare_error_bound = plan.error_bound;
     report.glare_sources = plan.sources;
     report.glare = settings.glare.enabled ? "skipped" : "off";
+    // An image that, with the glare's margin, exceeds the GL driver's textures
+    // takes the CPU path (a 1 x 16368 film with glare failed on GL).
+    if (gl != nullptr) {
+        const int margin = plan.enabled && plan.sources > 0 ? plan.kernel->radius : 0;
+        if (std::max(linear.width, linear.height) + 2 * margin > gl->max_texture_size()) gl = nullptr;
+    }
     if (gl != nullptr) {
         // Few pixels to spread: the CPU splats them (apply_glare_plan) and the
         // GPU tone-maps. Many: the GPU convolves the whole edge-extended image

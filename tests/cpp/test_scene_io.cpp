@@ -462,17 +462,17 @@ const std::vector<BadCase> bad_cases = {
     {"spot intensity negative", [](json& j) { j["lights"][2]["intensity"] = -1; }, Kind::value, "lights[2].intensity",
      "must be >= 0"},
     {"spot cone_angle 0", [](json& j) { j["lights"][2]["cone_angle"] = 0; }, Kind::value, "lights[2].cone_angle",
-     "must be in (0, 90]"},
+     "must be in [0.001, 90]"},
     {"spot cone_angle negative", [](json& j) { j["lights"][2]["cone_angle"] = -10; }, Kind::value,
-     "lights[2].cone_angle", "must be in (0, 90]"},
+     "lights[2].cone_angle", "must be in [0.001, 90]"},
     {"spot cone_angle tiny", [](json& j) { j["lights"][2]["cone_angle"] = 1e-60; }, Kind::value,
-     "lights[2].cone_angle", "must be in (0, 90]"},
+     "lights[2].cone_angle", "must be in [0.001, 90]"},
     {"spot cone_angle above 90", [](json& j) { j["lights"][2]["cone_angle"] = 90.5; }, Kind::value,
-     "lights[2].cone_angle", "must be in (0, 90]"},
+     "lights[2].cone_angle", "must be in [0.001, 90]"},
     {"spot cone_angle just above 90", [](json& j) { j["lights"][2]["cone_angle"] = 90.000000000001; }, Kind::value,
-     "lights[2].cone_angle", "must be in (0, 90]"},
+     "lights[2].cone_angle", "must be in [0.001, 90]"},
     {"spot cone_angle 180", [](json& j) { j["lights"][2]["cone_angle"] = 180; }, Kind::value, "lights[2].cone_angle",
-     "must be in (0, 90]"},
+     "must be in [0.001, 90]"},
     {"spot cone_angle NaN", [](json& j) { j["lights"][2]["cone_angle"] = nan; }, Kind::value, "lights[2].cone_angle",
      "must be finite"},
     {"spot cone_angle string", [](json& j) { j["lights"][2]["cone_angle"] = "25"; }, Kind::type,
@@ -513,7 +513,7 @@ const std::vector<BadCase> bad_cases = {
          l["cone_angle"] = 120;
          j["lights"].push_back(l);
      },
-     Kind::value, "lights[3].cone_angle", "must be in (0, 90]"},
+     Kind::value, "lights[3].cone_angle", "must be in [0.001, 90]"},
     {"spot before points",
      [](json& j) {
          json l = spot_light();

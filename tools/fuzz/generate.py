@@ -175,7 +175,7 @@ def _light(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
     if d.config.allows("spot") and d.chance(0.4):
         light["type"] = "spot"
         light["direction"] = d.direction()
-        light["cone_angle"] = d.value(lambda: d.rng.uniform(1.0, 90.0), [1e-4, 0.01, 1.0, 89.999, 90.0])
+        light["cone_angle"] = d.value(lambda: d.rng.uniform(1.0, 90.0), [1e-3, 0.01, 1.0, 89.999, 90.0])
         if d.chance(0.7):
             light["edge"] = d.value(lambda: d.rng.uniform(0, 1), [0.0, 1.0])
     else:
