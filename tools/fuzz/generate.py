@@ -209,7 +209,8 @@ def _surface(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
 def _camera(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
     position = d.point(centre, scale)
     while True:
-        target = d.point(centre, scale) if d.chance(0.7) else [p + x for p, x in zip(position, d.direction())]
+        target = (d.point(centre, scale) if d.chance(0.7)
+                  else [_clamp_coord(p + x) for p, x in zip(position, d.direction())])  # within the 1e7 bound
         view = [t - p for t, p in zip(target, position)]
         length = math.sqrt(sum(v * v for v in view))
         if length > 1e-4 * max(1.0, math.sqrt(sum(p * p for p in position))):
@@ -371,7 +372,8 @@ def _special_placements(d: _Draw, scene: Scene) -> None:
         normal = d.unit()
         surfaces.append({"type": "plane", "point": list(cam["position"]), "normal": list(normal)})
         tangent = _perpendicular(normal)
-        cam["look_at"] = [p + _reach(cam["position"]) * t for p, t in zip(cam["position"], tangent)]
+        reach = _reach(cam["position"])
+        cam["look_at"] = [_clamp_coord(p + reach * t) for p, t in zip(cam["position"], tangent)]
         cam["up"] = list(normal)  # a copy: no two places of a scene share a list
         scene["surfaces"] = surfaces
 
@@ -390,7 +392,7 @@ def _perpendicular(n: list[float]) -> list[float]:
 
 def _fix_look_at(d: _Draw, cam: dict[str, Any]) -> None:
     view = d.unit()
-    cam["look_at"] = [p + _reach(cam["position"]) * v for p, v in zip(cam["position"], view)]
+    cam["look_at"] = [_clamp_coord(p + _reach(cam["position"]) * v) for p, v in zip(cam["position"], view)]
     if abs(view[1]) > 0.99:
         cam["up"] = [1.0, 0.0, 0.0]
     else:
