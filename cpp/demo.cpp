@@ -339,9 +339,10 @@ int main(int argc, char** argv) {
         const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
         std::error_code error;
         if (!dir.empty() && !std::filesystem::is_directory(dir, error))
-            fail("--out: directory '" + dir.string() + "' does not exist");
+            fail("--out: cannot write '" + o.out + "': directory '" + dir.string() + "' does not exist");
         if (access(dir.empty() ? "." : dir.c_str(), W_OK) != 0)
-            fail("--out: directory '" + (dir.empty() ? std::string(".") : dir.string()) + "' is not writable");
+            fail("--out: cannot write '" + o.out + "': directory '" + (dir.empty() ? std::string(".") : dir.string()) +
+                 "' is not writable");
     }
     Scene scene;
     try {

@@ -21,7 +21,10 @@ float spot_profile_formula(SpotLightGpu s, float ct, float st2) {
 // inside is ct >= 0 and sin^2 theta <= sin^2 A (A <= 90 degrees), not ct >=
 // cos A, which float32 rounds to ct >= 1 for cones below about 0.02 degree.
 float spot_profile(SpotLightGpu s, float ct, float st2) {
-    return ct >= 0.0f && st2 <= s.cone.x ? spot_profile_formula(s, ct, st2) : 0.0f;
+    // Wide cones (cos A < 1/2) keep ct >= cos A, well conditioned there; sin^2 theta of a
+    // direction along a 90 degree cone's wall may round above sin^2 A = 1.
+    bool inside = s.axis_cos.w >= 0.5f ? ct >= 0.0f && st2 <= s.cone.x : ct >= s.axis_cos.w;
+    return inside ? spot_profile_formula(s, ct, st2) : 0.0f;
 }
 
 // I(theta) / I0 in the emission direction `dir` (unit) from the spot.
@@ -88,6 +91,8 @@ SpotRay spot_ray_frame(vec3 rel, vec3 axis, vec3 dir, float h_floor) {
 // in float32 for cones below about 0.02 degree (no light at all).
 bool spot_lit_at(SpotLightGpu s, SpotRay r, float tau) {
     float ax = tau * r.da - r.h * r.ma;
+    float c = s.axis_cos.w;
+    if (c < 0.5f) return ax >= 0.0f && ax * ax >= c * c * (tau * tau + r.h * r.h);  // wide: well conditioned
     float across = tau * r.ma + r.h * r.da;
     float off_axis2 = (tau * tau + r.h * r.h) * (r.na * r.na) + across * across;
     return ax >= 0.0f && off_axis2 <= s.cone.x * (tau * tau + r.h * r.h);
@@ -451,10 +456,13 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
     // sin A / st: phi_m = atan(sin A, sqrt(st^2 - sin^2 A)), accurate for any
     // cone (acos(sqrt(cos^2 A - ct^2) / st) loses the narrowest cones' phi_m
     // to the rounding of its argument near 1, and cos A rounds to 1 there).
+    bool narrow = cos_a >= 0.5f;  // wide cones keep the cosine forms, well conditioned there
     bool within = st * st <= s.cone.x;
-    bool inside = ct >= 0.0f && within;
-    bool every_phi = within;
-    float phi_m = every_phi ? PI : atan(sqrt(s.cone.x), sqrt(max(st * st - s.cone.x, 0.0f)));
+    bool inside = narrow ? ct >= 0.0f && within : ct >= cos_a;
+    bool every_phi = narrow ? within : inside || ct <= -cos_a;
+    float phi_m = every_phi ? PI
+                            : (narrow ? atan(sqrt(s.cone.x), sqrt(max(st * st - s.cone.x, 0.0f)))
+                                      : acos(min(sqrt(max(cos_a * cos_a - ct * ct, 0.0f)) / st, 1.0f)));
     // phi pieces, split where the receiver's plane makes the integrand kink
     // (phi_n +- pi/2), in the variable sv: phi = sv over the whole circle,
     // phi = phi_m sin(pi sv / 2) over the wedge sv in [-1, 1].
@@ -497,9 +505,9 @@ vec3 spot_surface_glow(SpotLightGpu s, vec3 p, vec3 n, int samples) {
         // float32 rounds cos A to 1 for cones below about 0.02 degree.
         float sin_phi = sin(phi);
         float off_circle2 = st * st * sin_phi * sin_phi;
-        if (!(off_circle2 < s.cone.x) || !(R > 0.0f)) continue;
+        if (narrow ? !(off_circle2 < s.cone.x) || !(R > 0.0f) : !(R > cos_a) || !(R > 0.0f)) continue;
         float beta = atan(y, x);
-        float gamma = atan(sqrt(s.cone.x - off_circle2), cos_a);
+        float gamma = narrow ? atan(sqrt(s.cone.x - off_circle2), cos_a) : acos(min(cos_a / R, 1.0f));
         float a0 = inside ? 0.0f : max(beta - gamma, 0.0f);
         float a1 = min(beta + gamma, PI);
         if (!(a1 > a0)) {  // beta < 0: the arc is the one about beta + 2 pi

@@ -131,4 +131,5 @@ def test_the_demo_reports_a_bad_out_directory_before_rendering(tmp_path):
                            "--width", "8000", "--height", "8000"],
                           capture_output=True, text=True, timeout=60, cwd=Path(__file__).resolve().parents[2])
     assert done.returncode == 2
-    assert done.stderr.strip() == f"airlight-demo: --out: directory '{missing}' does not exist", done.stderr
+    assert done.stderr.strip() == (f"airlight-demo: --out: cannot write '{missing / 'x.png'}': directory "
+                                   f"'{missing}' does not exist"), done.stderr
