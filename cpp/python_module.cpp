@@ -189,6 +189,18 @@ PYBIND11_MODULE(_core, m) {
     });
     py::register_exception<airlight::BackendUnavailable>(m, "BackendUnavailableError", PyExc_RuntimeError);
 
+    {
+        namespace lim = airlight::scene_limits;
+        py::dict limits;
+        limits["max_film_size"] = lim::max_film_size;
+        limits["max_film_pixels"] = lim::max_film_pixels;
+        limits["max_scene_file_bytes"] = lim::max_scene_file_bytes;
+        limits["min_light_radius"] = lim::min_light_radius;
+        limits["max_light_radius"] = lim::max_light_radius;
+        limits["default_light_radius"] = lim::default_light_radius;
+        limits["min_cone_angle"] = lim::min_cone_angle;
+        m.attr("scene_limits") = limits;  // include/airlight/scene_io.hpp, scene_limits
+    }
     m.def(
         "validate_scene", [](py::handle scene) { return airlight::scene_to_json(scene_from_python(scene), -1); },
         "Validates a scene (dict or JSON text) and returns it as normalised JSON text.");

@@ -37,16 +37,7 @@ AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
 
 namespace {
 
-constexpr int max_film_size = 16384;
-constexpr long max_film_pixels = 8192L * 8192L;
-constexpr double max_light_radius = 1e3;
-// The largest scene file read (a scene of 10^5 lamps is about 10 MiB).
-constexpr std::size_t max_scene_file_bytes = std::size_t(64) << 20;
-constexpr double default_light_radius = 0.05;
-// The narrowest spot, in degrees (1.7 cm wide at 1 km): below, float32 cannot
-// resolve the beam's glow on surfaces (at 1e-4 degree GL's was 31 % low, the
-// CPU's 0.5 %; at 1e-3 both are within 0.3 % of the reference).
-constexpr double min_cone_angle = 1e-3;
+using namespace scene_limits;
 
 enum class LightType { point, spot };
 
@@ -157,7 +148,7 @@ Medium parse_medium(const SceneObject& o) {
 }
 
 float read_light_radius(const SceneObject& o) {
-    if (auto v = o.opt("radius")) return read_positive(*v, max_light_radius, true);
+    if (auto v = o.opt("radius")) return read_in_range(*v, min_light_radius, max_light_radius, " m");
     return static_cast<float>(default_light_radius);
 }
 

@@ -6,7 +6,10 @@ import math
 from collections.abc import Sequence
 from typing import Any
 
+from . import _core
 from ._checks import _real, _rgb, _vec3
+
+_LIMITS: dict[str, Any] = _core.scene_limits  # the scene format's bounds (include/airlight/scene_io.hpp)
 
 
 def _sin_cos_degrees(angle: float) -> tuple[float, float]:
@@ -31,7 +34,7 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
     ``spacing / 2`` either side of the heading, ``height`` metres above
     ``position``, and shine along the heading tilted by ``pitch`` degrees
     (negative: down), with on-axis intensity ``intensity`` (W/sr, RGB),
-    half-angle ``cone_angle`` (degrees, in (0, 90]) and edge softness ``edge``
+    half-angle ``cone_angle`` (degrees, in [0.001, 90]) and edge softness ``edge``
     (in [0, 1]); see the README's scene format. ``radius`` is each lamp's
     emitting sphere. With ``lens_lamps=True`` two small point lamps of
     intensity ``lens_intensity`` and the same radius are added at the same
@@ -52,8 +55,8 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
         raise ValueError(f"height: must be >= 0, got {height!r}")
     rgb = _rgb("intensity", intensity)
     cone_angle = _real("cone_angle", cone_angle)
-    if not 0 < cone_angle <= 90:
-        raise ValueError(f"cone_angle: must be in (0, 90], got {cone_angle!r}")
+    if not _LIMITS["min_cone_angle"] <= cone_angle <= 90:
+        raise ValueError(f"cone_angle: must be in [{_LIMITS['min_cone_angle']:g}, 90], got {cone_angle!r}")
     edge = _real("edge", edge)
     if not 0 <= edge <= 1:
         raise ValueError(f"edge: must be in [0, 1], got {edge!r}")
@@ -64,8 +67,9 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
         raise TypeError(f"lens_lamps: expected a bool, got {type(lens_lamps).__name__}")
     lens_rgb = _rgb("lens_intensity", lens_intensity)
     radius = _real("radius", radius)
-    if not 0 < radius <= 1000:
-        raise ValueError(f"radius: must be in (0, 1000], got {radius!r}")
+    if not _LIMITS["min_light_radius"] <= radius <= _LIMITS["max_light_radius"]:
+        raise ValueError(f"radius: must be in [{_LIMITS['min_light_radius']:g}, {_LIMITS['max_light_radius']:g}], "
+                         f"got {radius!r}")
 
     sin_p, cos_p = _sin_cos_degrees(pitch)
     forward = (sin_h, 0.0, -cos_h)

@@ -16,8 +16,8 @@ SceneLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
 """A scene dict, a path to a JSON scene file, or JSON text."""
 
 _SCENES_DIR = Path(__file__).resolve().parent / "scenes"
-_MAX_FILM_SIZE = 16384
-_MAX_SCENE_FILE_BYTES = 64 << 20  # as cpp/scene_io.cpp's max_scene_file_bytes
+_MAX_FILM_SIZE: int = _core.scene_limits["max_film_size"]
+_MAX_SCENE_FILE_BYTES: int = _core.scene_limits["max_scene_file_bytes"]
 
 
 def _scene_source(scene: SceneLike) -> Any:

@@ -90,3 +90,22 @@ def test_the_narrowest_spot_is_0_001_degree():
     scene["lights"][1]["cone_angle"] = 9e-4
     with pytest.raises(ValueError, match=r"^lights\[1\]\.cone_angle: must be in \[0\.001, 90\]$"):
         airlight.load_scene(scene)
+
+
+def test_the_smallest_lamp_at_the_brightest_intensity_behind_dense_rain_renders_finite(renderer):
+    """Fuzz finding nonfinite-tiny-lamp-in-dense-rain: a 1e-7 m lamp of 1e30 W/sr has a core radiance
+    I / (pi r^2) = 3e43, past float32, and behind rain of transmittance 0 gave Inf x 0 = NaN. Lamps
+    are now at least 0.1 mm (I / (pi r^2) <= 3.2e37 at the intensity bound)."""
+    scene = {"film": {"width": 3, "height": 3},
+             "camera": {"position": [0, 0, 0], "look_at": [-900, 700, 0], "up": [0, 1, 0], "fov_y": 60},
+             "lights": [{"type": "point", "position": [-900, 700, 0], "intensity": 1e30, "radius": 1e-7}],
+             "atmosphere": {"rain": {"rate": 98.08, "density_scale": 1e6}}}
+    with pytest.raises(ValueError, match=r"^lights\[0\]\.radius: must be in \[0\.0001, 1000\] m \(got 1e-07\)$"):
+        airlight.load_scene(scene)
+    for rain in ({"rate": 98.08, "density_scale": 1e6}, {"rate": 0.1}):
+        scene["atmosphere"]["rain"] = rain
+        for light in (scene["lights"][0], {**scene["lights"][0], "type": "spot", "direction": [1, -1, 0],
+                                           "cone_angle": 90}):
+            scene["lights"] = [{**light, "radius": 1e-4}]
+            image = renderer.render(scene)
+            assert np.isfinite(image).all() and (image >= 0).all()

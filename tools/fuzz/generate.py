@@ -167,7 +167,7 @@ def _medium(d: _Draw) -> dict[str, Any] | None:
 
 
 def _radius(d: _Draw) -> float:
-    return d.value(lambda: d.log_uniform(1e-3, 1.0), [1e-7, 1e-4, 5.0, 1e3])
+    return d.value(lambda: d.log_uniform(1e-3, 1.0), [1e-4, 5.0, 1e3])  # 1e-4, 1e3: the bounds
 
 
 def _light(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
