@@ -5,7 +5,36 @@
 #   EFFECT_GL_SOURCES  C++ sources built only with the GL backend (its GL passes)
 #   EFFECT_GLSL_MATH   GLSL formulas shared by every GL program and compiled as
 #                      C++ in namespace airlight::shader (cpp/shader_cpp.hpp)
+#   EFFECT_GLSL_LAYOUT GLSL structs of the effect's frame data (std140-safe:
+#                      4-byte scalars in groups of four, vec4, ivec4), compiled
+#                      after the core's constants and before its FrameUniforms
+#   EFFECT_UNIFORMS    the effect's members of FrameUniforms, each "Type name"
+#                      (a struct of its EFFECT_GLSL_LAYOUT; "Type name[N]" for
+#                      an array): the shading pass reads frame.<name>, the C++
+#                      side fills FrameData::uniforms.<name>
 #   EFFECT_GLSL_PIXEL  GLSL functions of the per-pixel shading pass
+#   EFFECT_GLSL_TERMS  GLSL functions compiled after every effect's
+#                      EFFECT_GLSL_PIXEL (they may call any effect's): the
+#                      functions its hooks name
+#   EFFECT_HOOKS       the effect's terms in the integrator (shaders/shading.glsl),
+#                      each kind=function; the generated airlight_hooks.glsl
+#                      calls them in registry order. The kinds and signatures:
+#                      surface_irradiance  vec3 f(vec3 p, vec3 n, int self, vec3 so_far):
+#                                          irradiance on a surface point, summed
+#                      escaping_radiance   vec3 f(vec3 dir): radiance of a ray
+#                                          that meets nothing, summed onto background
+#                      emitter_hit         void f(vec3 origin, vec3 dir, INOUT(float) t_hit,
+#                                          INOUT(vec3) emitted, INOUT(bool) hit): an emitter
+#                                          nearer than t_hit sets t_hit, emitted, hit
+#                      view_transfer       vec3 f(vec3 origin, vec3 dir, float t_hit, vec3 radiance):
+#                                          a medium along the view ray [0, t_hit]
+#                                          attenuating `radiance` and adding its light
+#                      view_glow           same signature, after every view_transfer:
+#                                          light scattered toward the camera added
+#                                          to `radiance` (which also serves culling)
+#                      pixel_cores         vec3 f(int x, int row, vec3 radiance):
+#                                          the pixel's radiance with sub-pixel
+#                                          emitters composited over it
 #   EFFECT_FEATURES    shader switches, each name=MACRO: a bool of
 #                      shader::Features and a compile-time constant MACRO in
 #                      the GL variant / a member of the CPU shader
@@ -13,6 +42,15 @@
 #                      FrameData::tables, the GLSL/C++ constant TABLE_<NAME>
 #                      (its index; the GL sampler binding) for the texel
 #                      accessor table_texel4(TABLE_<NAME>, x, y)
+#   EFFECT_SCENE_HEADER a header of the effect's scene data types (included by
+#                      include/airlight/scene.hpp through the generated
+#                      airlight_scene_parts.hpp)
+#   EFFECT_SCENE_MEMBERS the effect's members of Scene, each "Type name"
+#   EFFECT_QUALITY     the effect's struct of settings in the scene's "quality"
+#                      object (a base of Quality, so its fields read
+#                      scene.quality.<field>); its keys EFFECT_QUALITY_KEYS are
+#                      parsed by parse_<name>_quality(const SceneObject&, Scene&)
+#                      and written by write_<name>_quality(const Scene&, json&)
 #   EFFECT_SCENE_KEYS  top-level scene keys the effect parses and writes back:
 #                      it defines parse_<name>_keys(const SceneObject&, Scene&)
 #                      and write_<name>_keys(const Scene&, nlohmann::json&)
@@ -42,6 +80,18 @@ set(AIRLIGHT_EFFECT_GL_SOURCES "")
 set(AIRLIGHT_EFFECT_DIRS "")
 set(AIRLIGHT_GLSL_MATH "")
 set(AIRLIGHT_GLSL_PIXEL "")
+set(AIRLIGHT_GLSL_LAYOUT "")
+set(AIRLIGHT_GLSL_TERMS "")
+set(AIRLIGHT_UNIFORM_LIST "")
+set(AIRLIGHT_SCENE_HEADERS "")
+set(AIRLIGHT_SCENE_MEMBER_LIST "")
+set(AIRLIGHT_QUALITY_BASES "")
+set(AIRLIGHT_QUALITY_KEY_EFFECTS "")
+set(AIRLIGHT_QUALITY_KEYS "")
+set(AIRLIGHT_HOOK_KINDS surface_irradiance escaping_radiance emitter_hit view_transfer view_glow pixel_cores)
+foreach(kind IN LISTS AIRLIGHT_HOOK_KINDS)
+  set(AIRLIGHT_HOOKS_${kind} "")
+endforeach()
 set(AIRLIGHT_FEATURE_LIST "")
 set(AIRLIGHT_TABLE_LIST "")
 set(AIRLIGHT_SCENE_KEY_EFFECTS "")
@@ -55,6 +105,14 @@ macro(airlight_declare declaration dir name)
   set(EFFECT_GL_SOURCES "")
   set(EFFECT_GLSL_MATH "")
   set(EFFECT_GLSL_PIXEL "")
+  set(EFFECT_GLSL_LAYOUT "")
+  set(EFFECT_UNIFORMS "")
+  set(EFFECT_SCENE_HEADER "")
+  set(EFFECT_SCENE_MEMBERS "")
+  set(EFFECT_QUALITY "")
+  set(EFFECT_QUALITY_KEYS "")
+  set(EFFECT_GLSL_TERMS "")
+  set(EFFECT_HOOKS "")
   set(EFFECT_FEATURES "")
   set(EFFECT_TABLES "")
   set(EFFECT_SCENE_KEYS "")
@@ -70,8 +128,31 @@ macro(airlight_declare declaration dir name)
   foreach(s IN LISTS EFFECT_GL_SOURCES)
     list(APPEND AIRLIGHT_EFFECT_GL_SOURCES ${dir}/${s})
   endforeach()
-  list(APPEND AIRLIGHT_GLSL_MATH ${EFFECT_GLSL_MATH})
+  if("${name}" STREQUAL "core")
+    set(AIRLIGHT_CORE_GLSL_MATH ${EFFECT_GLSL_MATH})  # before the effects' layouts (frame.glsl after them)
+  else()
+    list(APPEND AIRLIGHT_GLSL_MATH ${EFFECT_GLSL_MATH})
+  endif()
   list(APPEND AIRLIGHT_GLSL_PIXEL ${EFFECT_GLSL_PIXEL})
+  list(APPEND AIRLIGHT_GLSL_LAYOUT ${EFFECT_GLSL_LAYOUT})
+  list(APPEND AIRLIGHT_GLSL_TERMS ${EFFECT_GLSL_TERMS})
+  list(APPEND AIRLIGHT_UNIFORM_LIST ${EFFECT_UNIFORMS})
+  list(APPEND AIRLIGHT_SCENE_HEADERS ${EFFECT_SCENE_HEADER})
+  list(APPEND AIRLIGHT_SCENE_MEMBER_LIST ${EFFECT_SCENE_MEMBERS})
+  list(APPEND AIRLIGHT_QUALITY_BASES ${EFFECT_QUALITY})
+  if(EFFECT_QUALITY_KEYS)
+    list(APPEND AIRLIGHT_QUALITY_KEY_EFFECTS ${name})
+    list(APPEND AIRLIGHT_QUALITY_KEYS ${EFFECT_QUALITY_KEYS})
+  endif()
+  foreach(hook IN LISTS EFFECT_HOOKS)
+    string(REPLACE "=" ";" pair "${hook}")
+    list(GET pair 0 kind)
+    list(GET pair 1 function)
+    if(NOT kind IN_LIST AIRLIGHT_HOOK_KINDS)
+      message(FATAL_ERROR "effect ${name}: unknown hook kind ${kind} (cmake/effects.cmake lists them)")
+    endif()
+    list(APPEND AIRLIGHT_HOOKS_${kind} ${function})
+  endforeach()
   list(APPEND AIRLIGHT_FEATURE_LIST ${EFFECT_FEATURES})
   list(APPEND AIRLIGHT_TABLE_LIST ${EFFECT_TABLES})
   if(EFFECT_SCENE_KEYS)
@@ -121,6 +202,15 @@ function(airlight_write_registry output)
   foreach(k IN LISTS AIRLIGHT_SCENE_KEYS)
     string(APPEND text " \"${k}\",")
   endforeach()
+  string(APPEND text "\n\n// X(effect) for every effect that parses keys of the \"quality\" object, and those keys.\n")
+  string(APPEND text "#define AIRLIGHT_QUALITY_KEY_EFFECTS(X)")
+  foreach(e IN LISTS AIRLIGHT_QUALITY_KEY_EFFECTS)
+    string(APPEND text " \\\n    X(${e})")
+  endforeach()
+  string(APPEND text "\n#define AIRLIGHT_EFFECT_QUALITY_KEYS")
+  foreach(k IN LISTS AIRLIGHT_QUALITY_KEYS)
+    string(APPEND text " \"${k}\",")
+  endforeach()
   string(APPEND text "\n\n// X(effect) for every effect that fills its part of the frame, then those that pick tables after.\n")
   string(APPEND text "#define AIRLIGHT_FRAME_EFFECTS(X)")
   foreach(e IN LISTS AIRLIGHT_FRAME_EFFECTS)
@@ -145,10 +235,54 @@ function(airlight_write_registry output)
     math(EXPR index "${index} + 1")
   endforeach()
   string(APPEND glsl "CONST int TABLE_COUNT = ${index};\n")
+  string(APPEND glsl "\n// The effects' members of FrameUniforms (their EFFECT_UNIFORMS), in registry order.\n")
+  string(APPEND glsl "#define AIRLIGHT_EFFECT_UNIFORMS")
+  foreach(u IN LISTS AIRLIGHT_UNIFORM_LIST)
+    string(APPEND glsl " \\\n    ${u};")
+  endforeach()
+  string(APPEND glsl "\n")
   get_filename_component(dir ${output} DIRECTORY)
   file(WRITE ${dir}/airlight_registry.glsl.tmp "${glsl}")
   file(COPY_FILE ${dir}/airlight_registry.glsl.tmp ${dir}/airlight_registry.glsl ONLY_IF_DIFFERENT)
-  list(PREPEND AIRLIGHT_GLSL_MATH airlight_registry.glsl)
+  # The integrator's hooks (EFFECT_HOOKS): each kind's functions called in registry order.
+  set(hooks "// Generated by cmake/effects.cmake from the effects' EFFECT_HOOKS: do not edit.\n")
+  string(APPEND hooks "// The integrator (shading.glsl) calls these; each effect's function returns at once\n")
+  string(APPEND hooks "// when its switches are off (compile-time constants in a GL variant).\n\n")
+  string(APPEND hooks "vec3 hooks_surface_irradiance(vec3 p, vec3 n, int self) {\n    vec3 irradiance = vec3(0.0f);\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_surface_irradiance)
+    string(APPEND hooks "    irradiance += ${f}(p, n, self, irradiance);\n")
+  endforeach()
+  string(APPEND hooks "    return irradiance;\n}\n\n")
+  string(APPEND hooks "vec3 hooks_escaping_radiance(vec3 dir) {\n    vec3 radiance = vec3(0.0f);\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_escaping_radiance)
+    string(APPEND hooks "    radiance += ${f}(dir);\n")
+  endforeach()
+  string(APPEND hooks "    return radiance;\n}\n\n")
+  string(APPEND hooks "void hooks_emitter_hit(vec3 origin, vec3 dir, INOUT(float) t_hit, INOUT(vec3) emitted, INOUT(bool) hit) {\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_emitter_hit)
+    string(APPEND hooks "    ${f}(origin, dir, t_hit, emitted, hit);\n")
+  endforeach()
+  string(APPEND hooks "}\n\n")
+  string(APPEND hooks "vec3 hooks_view_segment(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_view_transfer AIRLIGHT_HOOKS_view_glow)
+    string(APPEND hooks "    radiance = ${f}(origin, dir, t_hit, radiance);\n")
+  endforeach()
+  string(APPEND hooks "    return radiance;\n}\n\n")
+  string(APPEND hooks "vec3 hooks_pixel_cores(int x, int row, vec3 radiance) {\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_pixel_cores)
+    string(APPEND hooks "    radiance = ${f}(x, row, radiance);\n")
+  endforeach()
+  string(APPEND hooks "    return radiance;\n}\n")
+  file(WRITE ${dir}/airlight_hooks.glsl.tmp "${hooks}")
+  file(COPY_FILE ${dir}/airlight_hooks.glsl.tmp ${dir}/airlight_hooks.glsl ONLY_IF_DIFFERENT)
+  # Compilation order: the registry's constants, the core's formulas, every
+  # effect's layout, the frame (FrameUniforms), every effect's formulas; then
+  # the core's and every effect's per-pixel functions, their terms, the hooks
+  # and the integrator.
+  set(math_order airlight_registry.glsl ${AIRLIGHT_CORE_GLSL_MATH} ${AIRLIGHT_GLSL_LAYOUT} ${AIRLIGHT_FRAME_GLSL}
+      ${AIRLIGHT_GLSL_MATH})
+  set(AIRLIGHT_GLSL_MATH ${math_order})
+  list(APPEND AIRLIGHT_GLSL_PIXEL ${AIRLIGHT_GLSL_TERMS} airlight_hooks.glsl ${AIRLIGHT_INTEGRATOR_GLSL})
   string(APPEND text "\n\n// The GLSL files in compilation order: formulas, then the shading pass's functions.\n")
   string(APPEND text "#define AIRLIGHT_GLSL_MATH_FILES")
   foreach(g IN LISTS AIRLIGHT_GLSL_MATH)
@@ -159,6 +293,24 @@ function(airlight_write_registry output)
     string(APPEND text " \"${g}\",")
   endforeach()
   string(APPEND text "\n")
+  # The effects' scene data: their headers, their members of Scene, their quality settings.
+  set(parts "// Generated by cmake/effects.cmake from the effects' EFFECT_SCENE_*: do not edit.\n#pragma once\n\n")
+  foreach(h IN LISTS AIRLIGHT_SCENE_HEADERS)
+    string(APPEND parts "#include \"${h}\"\n")
+  endforeach()
+  string(APPEND parts "\n// The effects' members of Scene (EFFECT_SCENE_MEMBERS), in registry order.\n")
+  string(APPEND parts "#define AIRLIGHT_EFFECT_SCENE_MEMBERS")
+  foreach(m IN LISTS AIRLIGHT_SCENE_MEMBER_LIST)
+    string(APPEND parts " \\\n    ${m};")
+  endforeach()
+  string(APPEND parts "\n\n// The effects' quality settings (EFFECT_QUALITY): the bases of Quality after the core's.\n")
+  string(APPEND parts "#define AIRLIGHT_EFFECT_QUALITY_BASES")
+  foreach(b IN LISTS AIRLIGHT_QUALITY_BASES)
+    string(APPEND parts " , public ${b}")
+  endforeach()
+  string(APPEND parts "\n")
+  file(WRITE ${dir}/airlight_scene_parts.hpp.tmp "${parts}")
+  file(COPY_FILE ${dir}/airlight_scene_parts.hpp.tmp ${dir}/airlight_scene_parts.hpp ONLY_IF_DIFFERENT)
   file(WRITE ${output}.tmp "${text}")
   file(COPY_FILE ${output}.tmp ${output} ONLY_IF_DIFFERENT)
   # The same files as #include lines, for the C++ compilation of the shared GLSL.

@@ -63,7 +63,12 @@ struct CpuShader {
     BvhNodeGpu bvh_node(int i) const { return bvh_nodes[i]; }
 
 // The shading pass's functions: the core's and every effect's, in registry order.
+// A hook has its kind's signature (cmake/effects.cmake), whose arguments not
+// every effect needs.
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wunused-parameter"
 #include "airlight_glsl_pixel.inc"
+#pragma GCC diagnostic pop
 
     // Texel (x, y) of the grid pass that fills table slot `slot` (AIRLIGHT_GRID_PASSES).
     vec4 run_grid_pass(int slot, int x, int y) {

@@ -97,7 +97,6 @@ FrameData make_frame_data(const Scene& scene) {
     f.cull_fraction = scene.quality.cull_fraction;
     f.march_steps = float(scene.quality.march_steps);
     f.march_far = march_far;
-    f.spot_glow_samples = float(scene.quality.spot_glow_samples);
     // Surfaces: the planes (unbounded, tested one by one), then the bounded
     // surfaces ordered by the leaves of a BVH built over them.
     std::vector<BoundedSurface> bounded;

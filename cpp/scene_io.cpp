@@ -20,7 +20,6 @@
 #include <vector>
 
 #include "airlight_registry.hpp"
-#include "rainbow.hpp"
 #include "scene_json.hpp"
 #include "scene_keys.hpp"
 
@@ -33,6 +32,12 @@ using namespace scene_keys;
     void parse_##e##_keys(const SceneObject& top, Scene& s); \
     void write_##e##_keys(const Scene& s, json& j);
 AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
+// ... and their keys of the "quality" object (EFFECT_QUALITY_KEYS).
+#define AIRLIGHT_X(e)                                               \
+    void parse_##e##_quality(const SceneObject& quality, Scene& s); \
+    void write_##e##_quality(const Scene& s, json& quality);
+AIRLIGHT_QUALITY_KEY_EFFECTS(AIRLIGHT_X)
 #undef AIRLIGHT_X
 
 namespace {
@@ -147,9 +152,23 @@ Medium parse_medium(const SceneObject& o) {
     return m;
 }
 
-float read_light_radius(const SceneObject& o) {
-    if (auto v = o.opt("radius")) return read_in_range(*v, min_light_radius, max_light_radius, " m");
-    return static_cast<float>(default_light_radius);
+// A lamp's radius in [min_light_radius, max_light_radius], and its core
+// radiance I / (pi r^2) (the largest channel of the intensity, on a spot's
+// axis) at most max_radiometric, like every radiance of the scene.
+float read_light_radius(const SceneObject& o, const Rgb& intensity) {
+    std::optional<Value> given = o.opt("radius");
+    const float r =
+        given ? read_in_range(*given, min_light_radius, max_light_radius, " m") : float(default_light_radius);
+    const double peak = std::max({double(intensity.x), double(intensity.y), double(intensity.z)});
+    const double radiance = peak / (3.14159265358979 * double(r) * double(r));
+    if (radiance > max_radiometric) {
+        const std::string field = given ? given->field : o.req("intensity").field;
+        fail(Kind::value, field,
+             "the lamp's core radiance intensity / (pi radius^2) = " + format_number(radiance) + " exceeds " +
+                 format_number(max_radiometric) + (given ? "" : " (radius 0.05 m by default)") +
+                 ": give a larger radius or a smaller intensity");
+    }
+    return r;
 }
 
 PointLight parse_point_light(const SceneObject& o) {
@@ -157,7 +176,7 @@ PointLight parse_point_light(const SceneObject& o) {
     PointLight l;
     l.position = read_vec3(o.req("position"));
     l.intensity = read_rgb(o.req("intensity"));
-    l.radius = read_light_radius(o);
+    l.radius = read_light_radius(o, l.intensity);
     return l;
 }
 
@@ -180,7 +199,7 @@ SpotLight parse_spot_light(const SceneObject& o) {
         if (edge < 0 || edge > 1) fail(Kind::value, v->field, "must be in [0, 1]");
         l.edge = static_cast<float>(edge);
     }
-    l.radius = read_light_radius(o);
+    l.radius = read_light_radius(o, l.intensity);
     return l;
 }
 
@@ -229,10 +248,11 @@ Surface parse_surface(const SceneObject& o) {
     return s;
 }
 
-Quality parse_quality(const SceneObject& o) {
-    o.check_keys({"airlight", "march_steps", "cull_fraction", "spot_glow_samples", "sky_segments",
-                  "rainbow_wavelengths", "sun_shadow_map"});
-    Quality q;
+// The "quality" object: the core's keys here, each effect's in its
+// parse_<name>_quality (EFFECT_QUALITY_KEYS).
+void parse_quality(const SceneObject& o, Scene& s) {
+    o.check_keys({"airlight", "march_steps", "cull_fraction", AIRLIGHT_EFFECT_QUALITY_KEYS});
+    Quality& q = s.quality;
     if (auto v = o.opt("airlight")) q.airlight = read_enum(*v, "airlight", airlight_methods);
     if (auto v = o.opt("march_steps")) q.march_steps = read_int(*v, 1, 65536);
     if (auto v = o.opt("cull_fraction")) {
@@ -240,25 +260,9 @@ Quality parse_quality(const SceneObject& o) {
         if (x < 0 || x > 0.01) fail(Kind::value, v->field, "must be in [0, 0.01]");
         q.cull_fraction = static_cast<float>(x);
     }
-    if (auto v = o.opt("spot_glow_samples")) {
-        q.spot_glow_samples = read_int(*v, 4, 64);
-        if (q.spot_glow_samples % 4 != 0) fail(Kind::value, v->field, "must be a multiple of 4");
-    }
-    if (auto v = o.opt("sky_segments")) q.sky_segments = read_int(*v, 2, 64);
-    if (auto v = o.opt("rainbow_wavelengths")) {
-        q.rainbow_wavelengths = read_int(*v, 3, RAINBOW_WAVELENGTHS);
-        if (!is_rainbow_wavelength_count(q.rainbow_wavelengths))
-            fail(Kind::value, v->field,
-                 std::string("must be ") + RAINBOW_WAVELENGTH_COUNTS + " (wavelength nodes), got " +
-                     std::to_string(q.rainbow_wavelengths));
-    }
-    if (auto v = o.opt("sun_shadow_map")) {
-        q.sun_shadow_map = read_int(*v, 0, 4096);
-        if (q.sun_shadow_map != 0 && q.sun_shadow_map < 16)
-            fail(Kind::value, v->field,
-                 "must be 0 (shadow rays) or in [16, 4096] (texels), got " + std::to_string(q.sun_shadow_map));
-    }
-    return q;
+#define AIRLIGHT_X(e) parse_##e##_quality(o, s);
+    AIRLIGHT_QUALITY_KEY_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
 }
 
 }  // namespace
@@ -278,7 +282,7 @@ Scene parse_scene_json(const json& j) {
     parse_lights(top.opt("lights"), s);
     s.surfaces = read_list<Surface>(top.opt("surfaces"), parse_surface);
     if (auto v = top.opt("background")) s.background = read_rgb(*v);
-    if (auto v = top.opt("quality")) s.quality = parse_quality(SceneObject(*v));
+    if (auto v = top.opt("quality")) parse_quality(SceneObject(*v), s);
 #define AIRLIGHT_X(e) parse_##e##_keys(top, s);
     AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
 #undef AIRLIGHT_X
@@ -353,11 +357,10 @@ json scene_to_json_value(const Scene& s) {
     j["background"] = json_vec3(s.background);
     j["quality"] = {{"airlight", name_of(airlight_methods, s.quality.airlight)},
                     {"march_steps", s.quality.march_steps},
-                    {"cull_fraction", json_number(s.quality.cull_fraction)},
-                    {"spot_glow_samples", s.quality.spot_glow_samples},
-                    {"sky_segments", s.quality.sky_segments},
-                    {"rainbow_wavelengths", s.quality.rainbow_wavelengths},
-                    {"sun_shadow_map", s.quality.sun_shadow_map}};
+                    {"cull_fraction", json_number(s.quality.cull_fraction)}};
+#define AIRLIGHT_X(e) write_##e##_quality(s, j["quality"]);
+    AIRLIGHT_QUALITY_KEY_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
 #define AIRLIGHT_X(e) write_##e##_keys(s, j);
     AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
 #undef AIRLIGHT_X

@@ -23,7 +23,7 @@ void pack_daytime_frame(const Scene& scene, FrameData& data) {
     std::vector<float> levels;
     if (data.features.atmosphere) levels = make_altitude_levels(f.species, scene.quality.sky_segments, top);
     for (size_t k = 0; k < levels.size() && k < size_t(shader::ATMOSPHERE_MAX_LEVELS); ++k)
-        f.altitude_levels[k / 4][int(k % 4)] = levels[k];
+        f.atmosphere.levels[k / 4][int(k % 4)] = levels[k];
     // The table: with its columns for a sky that lights an atmosphere, C = 0
     // only for one that lights surfaces through clear air.
     const bool columns = data.features.sky && data.features.atmosphere;
@@ -32,10 +32,10 @@ void pack_daytime_frame(const Scene& scene, FrameData& data) {
         data.use_table(shader::TABLE_SKY_PHASE, sky_phase_table(f.sky, f.species, columns));
         sky_table = data.tables[shader::TABLE_SKY_PHASE];
     }
-    f.atmosphere_top = top;
-    f.altitude_level_count = float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS)));
-    f.sky_table_columns = sky_table ? float(sky_table->width) : 1.0f;
-    f.sky_table_azimuth_blocks = sky_table ? float(sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f;
+    f.atmosphere.top = top;
+    f.atmosphere.level_count = float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS)));
+    f.atmosphere.sky_table_columns = sky_table ? float(sky_table->width) : 1.0f;
+    f.atmosphere.sky_table_azimuth_blocks = sky_table ? float(sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f;
 }
 
 }  // namespace airlight

@@ -156,3 +156,14 @@ void write_daytime_keys(const Scene& s, json& j) {
 }
 
 }  // namespace airlight
+
+namespace airlight {
+
+// The quality key "sky_segments" (EFFECT_QUALITY_KEYS).
+void parse_daytime_quality(const SceneObject& quality, Scene& s) {
+    if (auto v = quality.opt("sky_segments")) s.quality.sky_segments = read_int(*v, 2, 64);
+}
+
+void write_daytime_quality(const Scene& s, json& quality) { quality["sky_segments"] = s.quality.sky_segments; }
+
+}  // namespace airlight

@@ -12,3 +12,18 @@ set(EFFECT_FEATURES
 set(EFFECT_TABLES
     sky_phase)  # F_k(C, d): the sky dome through each species' phase function
 set(EFFECT_FRAME 1)
+set(EFFECT_GLSL_LAYOUT daytime_layout.glsl)
+set(EFFECT_UNIFORMS
+    "SkyGpu sky"
+    "SpeciesGpu species[SPECIES_COUNT]"  # SPECIES_MOLECULES, SPECIES_AEROSOL, SPECIES_RAIN (phase.z = 0 when absent)
+    "AtmosphereGpu atmosphere")
+set(EFFECT_GLSL_TERMS daytime_terms.glsl)
+set(EFFECT_HOOKS
+    surface_irradiance=sky_surface_irradiance
+    surface_irradiance=sun_surface_irradiance
+    escaping_radiance=sky_escaping_radiance
+    view_transfer=atmosphere_view_transfer)
+set(EFFECT_SCENE_HEADER daytime_scene.hpp)
+set(EFFECT_SCENE_MEMBERS "Sky sky" "Sun sun" "Atmosphere atmosphere")
+set(EFFECT_QUALITY DaytimeQuality)
+set(EFFECT_QUALITY_KEYS sky_segments)

@@ -6,11 +6,11 @@
 // Requires table_texel4(TABLE_SKY_PHASE, x, y) and the pure formulas of sky_math.glsl.
 
 float altitude_level(int k) {
-    return frame.altitude_levels[k >> 2][k & 3];
+    return frame.atmosphere.levels[k >> 2][k & 3];
 }
 
 int altitude_level_count() {
-    return int(frame.altitude_level_count);
+    return int(frame.atmosphere.level_count);
 }
 
 bool species_present(int i) {
@@ -76,7 +76,7 @@ struct SkyTableDirection {
 
 SkyTableDirection sky_table_direction(vec3 d) {
     vec2 angles = sky_table_angles(d, vec3(frame.sky.sun_direction));
-    int n_az = int(frame.sky_table_azimuth_blocks);
+    int n_az = int(frame.atmosphere.sky_table_azimuth_blocks);
     float fe = clamp(angles.x / PI + 0.5f, 0.0f, 1.0f) * float(SKY_TABLE_N_ELEVATION - 1);
     int ie = min(int(fe), SKY_TABLE_N_ELEVATION - 2);
     float fa = n_az > 1 ? clamp(angles.y / PI, 0.0f, 1.0f) * float(n_az - 1) : 0.0f;
@@ -93,7 +93,7 @@ SkyTableDirection sky_table_direction(vec3 d) {
 // column C for the direction cell t, by manual trilinear interpolation of
 // log(F e^C + floor) (exact float arithmetic, the same on GPU and CPU).
 vec4 sky_table_kernels(SkyTableDirection t, float column) {
-    int nc = int(frame.sky_table_columns);
+    int nc = int(frame.atmosphere.sky_table_columns);
     int ix = 0;
     float ax = 0.0f;
     if (nc > 1) {
@@ -198,7 +198,7 @@ void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigm
 // The part [s_in, s_out] of the ray o + s d (s_out <= s_end) inside the
 // atmosphere's slab 0 <= y <= top; false when the ray misses it.
 bool atmosphere_interval(vec3 o, vec3 d, float s_end, OUT(float) s_in, OUT(float) s_out) {
-    float top = frame.atmosphere_top;
+    float top = frame.atmosphere.top;
     if (d.y > 0.0f) {
         s_in = max(0.0f, -o.y / d.y);
         s_out = (top - o.y) / d.y;
@@ -297,7 +297,7 @@ void volume_end(vec3 o, float mu, float s_in, float s_out, float y_a, OUT(float)
             y_b = altitude_level(k);
         }
     }
-    if (s_b == s_out && mu != 0.0f) y_b = clamp(o.y + mu * s_out, 0.0f, frame.atmosphere_top);
+    if (s_b == s_out && mu != 0.0f) y_b = clamp(o.y + mu * s_out, 0.0f, frame.atmosphere.top);
 }
 
 // int_0^dtau e^{-t} S(t) dt for a source S that varies exponentially in
@@ -371,7 +371,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     if (HAS_SUN) sun_phase = sun_phase_along(d);
     float mu = d.y;
     float y_a = o.y + mu * s_in;
-    if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere_top);
+    if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.top);
     float s_a = s_in;
     vec3 weight = exp(-sigma_medium * s_in);  // transmittance from the camera to s_a, medium included
     SpeciesLight light_a = species_light(t, atmosphere_column(y_a), sun_phase);
@@ -441,7 +441,7 @@ vec3 atmosphere_transmittance(vec3 o, vec3 d, float s_end) {
 float march_far_distance(vec3 o, vec3 d, float s_in, float s_out, vec3 sigma_medium) {
     float mu = d.y;
     float y_a = o.y + mu * s_in;
-    if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere_top);
+    if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.top);
     float s_a = s_in;
     vec3 tau = sigma_medium * s_in;
     for (int step = 0; step < ATMOSPHERE_MAX_LEVELS + 2 && s_a < s_out; ++step) {
@@ -480,7 +480,7 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     vec3 tau = vec3(0.0f);  // the atmosphere's, from s_in (summed, not multiplied: no drift in float32)
     for (int step = 0; step < steps; ++step) {
         float s = s_in + (float(step) + 0.5f) * ds;
-        float y = clamp(o.y + d.y * s, 0.0f, frame.atmosphere_top);
+        float y = clamp(o.y + d.y * s, 0.0f, frame.atmosphere.top);
         vec3 sigma;
         vec3 j;
         atmosphere_point(y, y, species_light(t, atmosphere_column(y), sun_phase), sigma, j);

@@ -11,3 +11,10 @@ set(EFFECT_TABLES
     surface_glow)   # log G(T, theta_s)
 set(EFFECT_FRAME 1)
 set(EFFECT_FRAME_TABLES 1)
+set(EFFECT_GLSL_LAYOUT airlight_layout.glsl)  # the tables' sizes and ranges
+set(EFFECT_GLSL_TERMS lamp_terms.glsl)
+set(EFFECT_HOOKS
+    surface_irradiance=point_light_irradiance  # direct light and glow on surfaces
+    emitter_hit=point_lights_emitter_hit       # the lamps' spheres
+    view_glow=point_lights_view_glow           # the airlight
+    pixel_cores=point_lights_pixel_cores)      # lamps smaller than a pixel

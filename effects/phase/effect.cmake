@@ -12,3 +12,5 @@ set(EFFECT_TABLES
     phase_glow_1)
 set(EFFECT_FRAME 1)
 set(EFFECT_FRAME_TABLES 1)
+set(EFFECT_GLSL_LAYOUT phase_layout.glsl)
+set(EFFECT_UNIFORMS "PhaseUniforms phase")

@@ -5,11 +5,11 @@
 // the pure lobe formulas of phase_math.glsl.
 
 int phase_lobe_count() {
-    return frame.phase_lobe_count;
+    return frame.phase.lobe_count;
 }
 
 PhaseLobeGpu phase_lobe(int lobe) {
-    return lobe == 0 ? frame.phase_lobe0 : frame.phase_lobe1;
+    return lobe == 0 ? frame.phase.lobe0 : frame.phase.lobe1;
 }
 
 // 4 pi p of the medium (docs/conventions.md; 1 when isotropic) at the angle

@@ -58,12 +58,12 @@ void pack_phase_frame(const Scene& scene, FrameData& data) {
     shader::FrameUniforms& f = data.frame;
     const auto lobes = scene_lobes(scene, data);
     data.features.phase = !lobes.empty();
-    f.phase_lobe_count = int(lobes.size());
+    f.phase.lobe_count = int(lobes.size());
     for (size_t i = 0; i < lobes.size(); ++i)
-        (i == 0 ? f.phase_lobe0 : f.phase_lobe1) = phase_lobe_gpu(lobes[i].first, lobes[i].second);
+        (i == 0 ? f.phase.lobe0 : f.phase.lobe1) = phase_lobe_gpu(lobes[i].first, lobes[i].second);
     // The culling bounds of an isotropic medium (effects/lamp_airlight/docs/culling.md).
-    f.phase_airlight_bound = 0.5f * shader::PI;
-    f.phase_glow_bound = shader::SURFACE_GLOW_G_BOUND;
+    f.phase.airlight_bound = 0.5f * shader::PI;
+    f.phase.glow_bound = shader::SURFACE_GLOW_G_BOUND;
 }
 
 void pick_phase_tables(const Scene& scene, FrameData& data) {
@@ -85,8 +85,8 @@ void pick_phase_tables(const Scene& scene, FrameData& data) {
         glow_bound += weight * (slice ? std::exp(double(*std::max_element(slice->texels.begin(), slice->texels.end())))
                                       : 2.0 * pi * pi * phase_airlight_bound(lobe));
     }
-    data.frame.phase_airlight_bound = float(airlight_bound * 1.0001);
-    data.frame.phase_glow_bound = float(glow_bound * 1.001);
+    data.frame.phase.airlight_bound = float(airlight_bound * 1.0001);
+    data.frame.phase.glow_bound = float(glow_bound * 1.001);
 }
 
 }  // namespace airlight

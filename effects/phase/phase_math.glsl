@@ -5,7 +5,7 @@
 //
 // The medium's phase function is a weighted sum of at most two lobes, each a
 // Henyey-Greenstein lobe of asymmetry g or the Rayleigh function. A lobe is
-// described by PhaseLobeGpu (layout.glsl):
+// described by PhaseLobeGpu (phase_layout.glsl):
 //   shape = (k, sqrt k, c, 1 / (1 - g)),  k = (1 - g) / (1 + g),  c = min(k, sqrt k)
 //   info  = (g, 1 for Rayleigh else 0, glow row-warp floor K_min, weight)
 // Rayleigh is tabulated in the isotropic variables: shape = (1, 1, 1, 1), g = 0.

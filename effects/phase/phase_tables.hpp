@@ -16,7 +16,7 @@ struct PhaseLobe {
     float g = 0.0f;
 };
 
-// The lobe's parameters as the shaders read them (layout.glsl), with its
+// The lobe's parameters as the shaders read them (phase_layout.glsl), with its
 // weight in the mixture.
 shader::PhaseLobeGpu phase_lobe_gpu(const PhaseLobe& lobe, float weight);
 

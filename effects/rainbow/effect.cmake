@@ -1,6 +1,6 @@
 # Rainbows: the raindrops' Lorenz-Mie phase function for sunlight, averaged
 # over drop sizes (physics.md; effects/rainbow/docs/rainbow.md).
-set(EFFECT_SOURCES mie.cpp rainbow.cpp rainbow_rgb.cpp rainbow_data.cpp rainbow_frame.cpp)
+set(EFFECT_SOURCES mie.cpp rainbow.cpp rainbow_rgb.cpp rainbow_data.cpp rainbow_frame.cpp rainbow_keys.cpp)
 set(EFFECT_FEATURES
     rainbow=HAS_RAINBOW)  # rain lit by the sun scatters with the Mie table
 set(EFFECT_TABLES
@@ -10,3 +10,6 @@ set(EFFECT_GLSL_PIXEL rainbow.glsl)
 # Its switch depends on the daytime effect's sun (registered before it, since
 # the daytime GLSL calls rainbow_phase): it is set when tables are picked.
 set(EFFECT_FRAME_TABLES 1)
+set(EFFECT_SCENE_HEADER rainbow_scene.hpp)
+set(EFFECT_QUALITY RainbowQuality)
+set(EFFECT_QUALITY_KEYS rainbow_wavelengths)

@@ -344,7 +344,7 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
     vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(s.intensity_edge) / (2.0f * PI * r.h);
     float min_sigma_t = min(min(sigma_t.x, sigma_t.y), sigma_t.z);
-    if (negligible(scale * (frame.phase_airlight_bound * exp(-min_sigma_t * max(dist - radius, 0.0f))), so_far)) return vec3(0.0f);
+    if (negligible(scale * (frame.phase.airlight_bound * exp(-min_sigma_t * max(dist - radius, 0.0f))), so_far)) return vec3(0.0f);
     float lo;
     float hi;
     bool wall_lo;

@@ -9,6 +9,7 @@
 namespace airlight {
 
 void pack_spotlights_frame(const Scene& scene, FrameData& data) {
+    data.frame.spot.glow_samples = float(scene.quality.spot_glow_samples);
     // What loses precision in float32 (the position relative to the camera,
     // sin^2 A, 1 - cos A) is formed in double (effects/spotlights/docs/spot_table.md).
     for (const SpotLight& spot : scene.spot_lights) {

@@ -12,9 +12,9 @@
 #include <string>
 #include <vector>
 
-#include "airlight/display_settings.hpp"
 #include "airlight/glare.hpp"
 #include "airlight/renderer.hpp"
+#include "display_settings.hpp"
 
 namespace airlight {
 

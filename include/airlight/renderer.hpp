@@ -13,7 +13,7 @@ namespace airlight {
 
 enum class Backend { cpu, gl };
 
-struct DisplaySettings;  // airlight/display_settings.hpp
+struct DisplaySettings;  // effects/display/display_settings.hpp
 struct DisplayImage;     // airlight/display.hpp
 
 const char* backend_name(Backend backend);

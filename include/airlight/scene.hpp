@@ -6,12 +6,11 @@
 #include <string>
 #include <vector>
 
-#include "airlight/display_settings.hpp"
+#include "airlight/rgb.hpp"
+// The effects' scene types (each effect's EFFECT_SCENE_HEADER) and their members of Scene.
+#include "airlight_scene_parts.hpp"
 
 namespace airlight {
-
-// Linear RGB triple (radiance, intensity, coefficients, albedo), per channel.
-using Rgb = glm::vec3;
 
 struct Film {
     int width = 320;
@@ -103,113 +102,25 @@ struct Surface {
     Rgb albedo{0.5f};
 };
 
-// ---- Daytime: sky dome, sun and a height-varying atmosphere (effects/daytime/physics.md;
-// issue 6; effects/daytime/docs/daytime.md). Altitude is y in metres above the
-// ground plane y = 0; the atmosphere exists for y >= 0.
-
-enum class SkyModel {
-    none,      // no sky: escaping rays see `background` only
-    overcast,  // the classic CIE standard overcast sky L = Lz (1 + 2 cos Z) / 3
-    cie,       // the CIE general sky, ISO 15469 type 1..15 (needs a sun position for types with an indicatrix)
-};
-
-// The sky dome: the radiance entering the atmosphere at its top, L(w) =
-// zenith_radiance x shape(w) for directions above the horizon, 0 below.
-struct Sky {
-    SkyModel model = SkyModel::none;
-    int cie_type = 1;  // 1..15, for SkyModel::cie
-    Rgb zenith_radiance{0.0f};
-};
-
-// A directional sun: `direction` is the unit vector toward the sun (scene
-// keys elevation/azimuth in degrees give (sin az cos el, sin el, -cos az cos el)),
-// `irradiance` the irradiance on a plane facing it at the top of the
-// atmosphere (W/m^2 per channel). Below the horizon it lights nothing; it
-// still sets the CIE sky's sun position.
-struct Sun {
-    bool present = false;
-    glm::vec3 direction{0.0f, 1.0f, 0.0f};
-    Rgb irradiance{0.0f};
-};
-
-// Air molecules: Rayleigh scattering, sea-level coefficients times
-// density_scale, scale height 8 km (effects/daytime/physics.md).
-struct Molecules {
-    bool present = false;
-    float density_scale = 1.0f;
-};
-
-// Aerosol (haze, fog): Henyey-Greenstein g, single-scattering albedo, grey
-// extinction at the ground given either by the visibility (Koschmieder,
-// 3.912 / V for the clear air, molecules included) or directly by the
-// coefficient; exponential decay with scale_height up to the minimum at
-// 2250 m, a 25 % rise to 3250 m, decay above (effects/daytime/physics.md).
-struct Aerosol {
-    bool present = false;
-    float visibility = 0.0f;   // m; > 0 when given
-    float coefficient = 0.0f;  // 1/m at the ground; used when visibility == 0
-    float scale_height = 1000.0f;
-    float g = 0.7f;
-    float albedo = 0.9f;
-};
-
-// Raindrops: Marshall-Palmer drop sizes for the rainfall rate (mm/h), whose
-// extinction is pi N0 / Lambda^3 (extinction efficiency 2) times
-// density_scale; constant density from the ground to `top` (the cloud base,
-// m); Henyey-Greenstein g of large drops.
-// How rain scatters the sun (effects/rainbow/physics.md): "mie", the drops'
-// Lorenz-Mie phase function averaged over the rate's drop sizes, per
-// wavelength (rainbows; effects/rainbow/rainbow.hpp); or "hg", Henyey-Greenstein with g.
-// Sky light is always scattered with HG g (the sky is smooth; effects/rainbow/docs/rainbow.md).
-enum class RainPhase { mie, hg };
-
-struct Rain {
-    bool present = false;
-    float rate = 0.0f;
-    float density_scale = 1.0f;  // drop density relative to the rate's (the fading rain of a rainbow)
-    float top = 1500.0f;
-    float g = 0.87f;
-    RainPhase phase = RainPhase::mie;
-};
-
-struct Atmosphere {
-    Molecules molecules;
-    Aerosol aerosol;
-    Rain rain;
-    bool any() const { return molecules.present || aerosol.present || rain.present; }
-};
-
 // How the airlight is computed (effects/lamp_airlight/physics.md).
 enum class AirlightMethod {
     analytic,  // the table method: exact up to the tables' measured error
     march,     // brute-force ray marching, for benchmarks and comparison
 };
 
-// Accuracy and speed settings (the "quality" object of the scene format).
-struct Quality {
+// Accuracy and speed settings (the "quality" object of the scene format):
+// the core's here, each effect's in its EFFECT_QUALITY struct, a base of
+// Quality (scene.quality.<field> reads either).
+struct CoreQuality {
     AirlightMethod airlight = AirlightMethod::analytic;
     int march_steps = 64;  // midpoint-rule steps per light and view ray, for "march"
     // A light is skipped wherever a bound proves its contribution to a pixel
     // below cull_fraction x the scene's reference radiance (effects/lamp_airlight/docs/culling.md);
     // 0 disables culling.
     float cull_fraction = 1e-5f;
-    // Directions per azimuth ring and rings of the quadrature over a spot's
-    // beam that gives the light it scatters onto surfaces (a multiple of 4 in
-    // [4, 64]; effects/spotlights/docs/spot_table.md section 9 measures its error).
-    int spot_glow_samples = 12;
-    // Accuracy knob of the daytime scattering volumes (effects/daytime/physics.md):
-    // the number of altitude levels that split view rays through the
-    // atmosphere (effects/daytime/docs/daytime.md measures error against it), in [2, 64].
-    int sky_segments = 16;
-    // Wavelength nodes (3, 5, 9, 17 or 33, 380-720 nm) of the rainbow's
-    // spectral phase function turned into RGB (effects/rainbow/docs/rainbow.md measures the
-    // colour error of fewer).
-    int rainbow_wavelengths = 33;
-    // The sun's shadows on surfaces: 0 traces a shadow ray per point (exact);
-    // N in [16, 4096] looks them up in a shadow map of N texels along its
-    // longer side, filled by a grid pass (effects/sun_shadow_map/physics.md).
-    int sun_shadow_map = 0;
 };
+
+struct Quality : public CoreQuality AIRLIGHT_EFFECT_QUALITY_BASES {};
 
 struct Scene {
     Film film;
@@ -220,13 +131,12 @@ struct Scene {
     std::vector<SpotLight> spot_lights;
     std::vector<Surface> surfaces;
     Rgb background{0.0f};  // radiance of rays that hit nothing (seen through the medium), added to the sky's
-    Sky sky;
-    Sun sun;
-    Atmosphere atmosphere;
     Quality quality;
-    // How the demo and Renderer::display turn the radiance into an image
-    // (issue 8); render() itself always returns linear radiance.
-    DisplaySettings display;
+    // The effects' parts (EFFECT_SCENE_MEMBERS): the daytime effect's sky,
+    // sun and atmosphere; the display effect's display settings (how the demo
+    // and Renderer::display turn the radiance into an image; render() itself
+    // always returns linear radiance).
+    AIRLIGHT_EFFECT_SCENE_MEMBERS
 };
 
 }  // namespace airlight

@@ -17,10 +17,11 @@ constexpr int max_film_size = 16384;
 constexpr long max_film_pixels = 8192L * 8192L;
 // The largest scene file read (a scene of 10^5 lamps is about 10 MiB).
 constexpr std::size_t max_scene_file_bytes = std::size_t(64) << 20;
-// A lamp's radius, in metres. Below 0.1 mm (an LED die is about 1 mm) the core
-// radiance I / (pi r^2) of a lamp at the intensity bound (1e30 W/sr) leaves
-// float32's range (a 1e-7 m lamp gave Inf, and NaN behind dense rain).
-constexpr double min_light_radius = 1e-4;
+// A lamp's radius, in metres: at least 1 micrometre (pi r^2 stays a normal
+// float32), and its core radiance I / (pi r^2) is a radiance, at most 1e30
+// like every other (a 1e-7 m lamp of 1e30 W/sr gave Inf, and NaN behind
+// dense rain).
+constexpr double min_light_radius = 1e-6;
 constexpr double max_light_radius = 1e3;
 constexpr double default_light_radius = 0.05;
 // The narrowest spot, in degrees (1.7 cm wide at 1 km): below, float32 cannot

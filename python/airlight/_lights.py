@@ -67,9 +67,9 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
         raise TypeError(f"lens_lamps: expected a bool, got {type(lens_lamps).__name__}")
     lens_rgb = _rgb("lens_intensity", lens_intensity)
     radius = _real("radius", radius)
-    if not _LIMITS["min_light_radius"] <= radius <= _LIMITS["max_light_radius"]:
-        raise ValueError(f"radius: must be in [{_LIMITS['min_light_radius']:g}, {_LIMITS['max_light_radius']:g}], "
-                         f"got {radius!r}")
+    lo, hi = _LIMITS["min_light_radius"], _LIMITS["max_light_radius"]
+    if not lo <= radius <= hi:
+        raise ValueError(f"radius: must be in [{lo:g}, {hi:g}], got {radius!r}")
 
     sin_p, cos_p = _sin_cos_degrees(pitch)
     forward = (sin_h, 0.0, -cos_h)

@@ -295,8 +295,9 @@ def render_reference(scene: Any, width: int | None = None, height: int | None = 
     hit_id[sees_surface] = index[sees_surface] * _FACES_PER_SURFACE + face[sees_surface]
     hit_id[sees_lamp] = LAMP_ID_BASE + lamp[sees_lamp]
     # Lamps smaller than a pixel are drawn box-filtered around where their centre
-    # projects (shading.glsl, lamp_subpixel_cores), which this reference does not
-    # model: the 5 x 5 pixels there get SUBPIXEL_CORE_ID, which smooth_mask leaves out.
+    # projects (point_lights_pixel_cores, effects/lamp_airlight/lamp_terms.glsl), which this
+    # reference does not model: the 5 x 5 pixels there get SUBPIXEL_CORE_ID, which smooth_mask
+    # leaves out.
     hit_id = hit_id.reshape(h, w)
     pixel_angle = 2.0 * math.tan(math.radians(sc["camera"]["fov_y"]) / 2.0) / h
     for light in lights:

@@ -7,20 +7,28 @@ position'; the test is now the float32 resolution of the coordinates."""
 
 from __future__ import annotations
 
+import math
+
 import numpy as np
 import pytest
 
 import airlight
 
 
+def smallest_radius(intensity: float) -> float:
+    """The smallest lamp radius whose core radiance I / (pi r^2) is within the 1e30 bound."""
+    return max(0.05, math.sqrt(intensity / (math.pi * 1e30)) * (1 + 1e-6))
+
+
 def lamp_scene(sigma_t: float, intensity: float, radius: float = 0.05, background: float = 0.0) -> dict:
+    radius = max(radius, smallest_radius(intensity))
     return {"film": {"width": 6, "height": 4},
             "camera": {"position": [0, 1.7, 0], "look_at": [0, 1, -10], "up": [0, 1, 0], "fov_y": 60},
             "medium": {"sigma_t": sigma_t, "albedo": 1.0}, "background": background,
             "lights": [{"type": "point", "position": [0.5, 1.5, -3], "intensity": intensity,
                         "radius": radius},
                        {"type": "spot", "position": [-1, 3, -4], "direction": [0, -1, 0],
-                        "intensity": intensity, "cone_angle": 30}],
+                        "intensity": intensity, "cone_angle": 30, "radius": radius}],
             "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 1.0},
                          {"type": "sphere", "center": [0, 1, -6], "radius": 1, "albedo": 1.0}]}
 
@@ -92,20 +100,25 @@ def test_the_narrowest_spot_is_0_001_degree():
         airlight.load_scene(scene)
 
 
-def test_the_smallest_lamp_at_the_brightest_intensity_behind_dense_rain_renders_finite(renderer):
+def test_a_lamp_core_brighter_than_the_radiance_bound_is_refused_and_at_the_bound_renders_finite(renderer):
     """Fuzz finding nonfinite-tiny-lamp-in-dense-rain: a 1e-7 m lamp of 1e30 W/sr has a core radiance
-    I / (pi r^2) = 3e43, past float32, and behind rain of transmittance 0 gave Inf x 0 = NaN. Lamps
-    are now at least 0.1 mm (I / (pi r^2) <= 3.2e37 at the intensity bound)."""
+    I / (pi r^2) = 3e43, past float32, and behind rain of transmittance 0 gave Inf x 0 = NaN. A lamp's
+    core radiance is now bounded like every radiance (1e30), and its radius is at least 1 micrometre."""
     scene = {"film": {"width": 3, "height": 3},
              "camera": {"position": [0, 0, 0], "look_at": [-900, 700, 0], "up": [0, 1, 0], "fov_y": 60},
              "lights": [{"type": "point", "position": [-900, 700, 0], "intensity": 1e30, "radius": 1e-7}],
              "atmosphere": {"rain": {"rate": 98.08, "density_scale": 1e6}}}
-    with pytest.raises(ValueError, match=r"^lights\[0\]\.radius: must be in \[0\.0001, 1000\] m \(got 1e-07\)$"):
+    with pytest.raises(ValueError,
+                       match=r"^lights\[0\]\.radius: must be in \[1e-06, 1000\] m \(got 1e-07\)$"):
+        airlight.load_scene(scene)
+    scene["lights"][0]["radius"] = 0.5
+    with pytest.raises(ValueError, match=r"^lights\[0\]\.radius: the lamp's core radiance .* exceeds 1e\+30"):
         airlight.load_scene(scene)
     for rain in ({"rate": 98.08, "density_scale": 1e6}, {"rate": 0.1}):
         scene["atmosphere"]["rain"] = rain
         for light in (scene["lights"][0], {**scene["lights"][0], "type": "spot", "direction": [1, -1, 0],
                                            "cone_angle": 90}):
-            scene["lights"] = [{**light, "radius": 1e-4}]
-            image = renderer.render(scene)
-            assert np.isfinite(image).all() and (image >= 0).all()
+            for intensity, radius in ((1e30, smallest_radius(1e30)), (1e18, 1e-6)):
+                scene["lights"] = [{**light, "intensity": intensity, "radius": radius}]
+                image = renderer.render(scene)
+                assert np.isfinite(image).all() and (image >= 0).all()

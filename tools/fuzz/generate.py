@@ -167,7 +167,13 @@ def _medium(d: _Draw) -> dict[str, Any] | None:
 
 
 def _radius(d: _Draw) -> float:
-    return d.value(lambda: d.log_uniform(1e-3, 1.0), [1e-4, 5.0, 1e3])  # 1e-4, 1e3: the bounds
+    return d.value(lambda: d.log_uniform(1e-3, 1.0), [1e-6, 1e-4, 5.0, 1e3])  # 1e-6, 1e3: the bounds
+
+
+def _core_radiance_radius(intensity: Any, radius: float) -> float:
+    """The radius raised, where needed, to keep the core radiance I / (pi r^2) within 1e30 (README)."""
+    peak = max(intensity) if isinstance(intensity, list) else float(intensity)
+    return max(radius, math.sqrt(peak / (math.pi * 1e30)) * (1 + 1e-6))
 
 
 def _light(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
@@ -180,8 +186,11 @@ def _light(d: _Draw, centre: list[float], scale: float) -> dict[str, Any]:
             light["edge"] = d.value(lambda: d.rng.uniform(0, 1), [0.0, 1.0])
     else:
         light["type"] = "point"
-    if d.chance(0.7):
-        light["radius"] = _radius(d)
+    given = d.chance(0.7)
+    radius = _radius(d) if given else 0.05  # 0.05: the default
+    raised = _core_radiance_radius(light["intensity"], radius)
+    if given or raised != radius:
+        light["radius"] = raised
     return light
 
 

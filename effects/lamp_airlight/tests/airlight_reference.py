@@ -528,7 +528,7 @@ def cull_reference_radiance(sc: Scene) -> float:
 def subpixel_core_pixels(sc: Scene, centres: Sequence[np.ndarray], margin: int = 2) -> np.ndarray:
     """Mask (H, W) of the pixels within ``margin`` pixels of where each lamp centre
     projects: a lamp smaller than a pixel is drawn box-filtered there (shading.glsl,
-    lamp_subpixel_cores), which this reference does not model."""
+    point_lights_pixel_cores), which this reference does not model."""
     h, w = sc.height, sc.width
     mask = np.zeros((h, w), dtype=bool)
     aspect = w / h

@@ -197,7 +197,7 @@ SliceErrors slice_errors(const PhaseLobe& l, int samples, std::mt19937& rng) {
     shader::PhaseSampler sampler;
     const auto table = phase_moment_table(l);
     sampler.moments = table.get();
-    sampler.frame.phase_lobe0 = phase_lobe_gpu(l, 1.0f);
+    sampler.frame.phase.lobe0 = phase_lobe_gpu(l, 1.0f);
     std::uniform_real_distribution<double> unit(0.0, 1.0);
     SliceErrors e;
     for (int i = 0; i < samples; ++i) {

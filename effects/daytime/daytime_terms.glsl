@@ -1,0 +1,40 @@
+// The daytime sky's and atmosphere's terms of the shading pass
+// (effects/daytime/physics.md), called through the integrator's hooks
+// (effect.cmake EFFECT_HOOKS): surface_irradiance (sky, then sun),
+// escaping_radiance, view_transfer.
+
+// Hook surface_irradiance: the sky dome's light on a surface point (sky.glsl).
+vec3 sky_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
+    if (!HAS_SKY) return vec3(0.0f);
+    return sky_irradiance(p, n);
+}
+
+// Hook surface_irradiance: the sun's, where the point sees it (sun_visibility:
+// a shadow ray, or the map of effects/sun_shadow_map).
+vec3 sun_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
+    if (!HAS_SUN || dot(n, vec3(frame.sky.sun_direction)) <= 0.0f) return vec3(0.0f);
+    float visible = sun_visibility(p, n, self);
+    return visible > 0.0f ? visible * sun_irradiance(p, n) : vec3(0.0f);
+}
+
+// Hook escaping_radiance: the sky dome seen by a ray that meets nothing.
+vec3 sky_escaping_radiance(vec3 dir) {
+    if (!HAS_SKY) return vec3(0.0f);
+    return sky_radiance(dir);
+}
+
+// Hook view_transfer: aerial perspective on whatever the ray ends at, plus the
+// sky and sun light the atmosphere's particles scatter toward the camera.
+vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
+    if (!HAS_ATMOSPHERE) return radiance;
+    vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
+    vec3 inscatter;
+    vec3 through_atmosphere;
+    if (SKY_MARCH) {
+        atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter,
+                                    through_atmosphere);
+    } else {
+        atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, through_atmosphere);
+    }
+    return radiance * through_atmosphere + inscatter;
+}

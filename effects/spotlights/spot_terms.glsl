@@ -1,0 +1,82 @@
+// The spotlights' terms of the shading pass (effects/spotlights/physics.md),
+// called through the integrator's hooks (effect.cmake EFFECT_HOOKS):
+// surface_irradiance, emitter_hit, view_glow, pixel_cores.
+
+// of p, inverse-square falloff, Lambert's cosine, attenuation and hard shadows
+// (effects/spotlights/physics.md); plus, in a scattering medium, the light each spot
+// scatters once on the way (spot_surface_glow, not shadowed), bounded for
+// culling by the glow of a point lamp of intensity I0 (the profile is <= 1).
+// p lies on surface `self`.
+// Hook surface_irradiance.
+vec3 spot_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
+    vec3 irradiance = vec3(0.0f);
+    if (!HAS_SPOT_LIGHTS) return irradiance;
+    vec3 shadow_origin = p + surface_offset(p) * n;
+    for (int i = 0; i < spot_light_count(); ++i) {
+        SpotLightGpu s = spot_light(i);
+        vec3 to_light = vec3(s.world_position) - p;
+        float dist2 = dot(to_light, to_light);
+        float dist = sqrt(dist2);
+        float radius = s.relative_position_radius.w;
+        if (dist <= 0.0f) continue;
+        vec3 l = to_light / dist;
+        float cos_theta = dot(n, l);
+        float profile = cos_theta > 0.0f ? spot_profile_toward(s, -l) : 0.0f;
+        vec3 intensity = vec3(s.intensity_edge);
+        vec3 attenuation = transmittance(dist);
+        vec3 direct = intensity * (max(profile, 0.0f) * cos_theta / max(dist2, radius * radius)) * attenuation;
+        if (profile <= 0.0f) direct = vec3(0.0f);
+        vec3 glow_bound = HAS_SPOT_AIRLIGHT ? surface_glow_bound(intensity, attenuation, dist, radius) : vec3(0.0f);
+        if (negligible(direct + glow_bound, irradiance + so_far)) continue;
+        if (HAS_SPOT_AIRLIGHT) irradiance += spot_surface_glow(s, p, n, int(frame.spot.glow_samples));
+        if (profile <= 0.0f) continue;
+        if (HAS_SURFACES && segment_occluded(shadow_origin, l, dist - radius, self)) continue;
+        irradiance += direct;
+    }
+    return irradiance;
+}
+
+// Hook view_glow: the airlight of every spot over [0, t_hit].
+vec3 spot_lights_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
+    if (!HAS_SPOT_AIRLIGHT) return radiance;
+    for (int i = 0; i < spot_light_count(); ++i) radiance += spot_light_airlight(i, dir, t_hit, radiance);
+    return radiance;
+}
+
+// Hook emitter_hit: a spot's sphere nearer than t_hit shows its profile in
+// the direction of the camera.
+void spot_lights_emitter_hit(vec3 origin, vec3 dir, INOUT(float) t_hit, INOUT(vec3) emitted, INOUT(bool) hit) {
+    if (!HAS_SPOT_LIGHTS) return;
+    for (int i = 0; i < spot_light_count(); ++i) {
+        SpotLightGpu s = spot_light(i);
+        if (lamp_is_subpixel(vec3(s.relative_position_radius), s.relative_position_radius.w)) continue;
+        PointLightGpu sphere;
+        sphere.position_radius = vec4(vec3(s.world_position), s.relative_position_radius.w);
+        sphere.intensity = s.intensity_edge;
+        float t = intersect_lamp(sphere, origin, dir);
+        if (t < t_hit) {
+            t_hit = t;
+            float r = s.relative_position_radius.w;
+            emitted = vec3(s.intensity_edge) *
+                      (spot_profile_toward(s, normalize(-vec3(s.relative_position_radius))) / (PI * r * r));
+            hit = true;
+        }
+    }
+}
+
+// Hook pixel_cores: the sub-pixel spot cores composited over the pixel
+// (composite_lamp_core, effects/lamp_airlight/lamp_terms.glsl), each with its
+// profile toward the camera.
+vec3 spot_lights_pixel_cores(int x, int row, vec3 radiance) {
+    if (!HAS_SPOT_LIGHTS) return radiance;
+    for (int i = 0; i < spot_light_count(); ++i) {
+        SpotLightGpu s = spot_light(i);
+        float r = s.relative_position_radius.w;
+        vec3 rel = vec3(s.relative_position_radius);
+        float cover = lamp_pixel_weight(rel, r, x, row);
+        if (cover <= 0.0f) continue;
+        vec3 core = vec3(s.intensity_edge) * (spot_profile_toward(s, -rel / length(rel)) / (PI * r * r));
+        radiance = composite_lamp_core(radiance, rel, r, cover, core);
+    }
+    return radiance;
+}
