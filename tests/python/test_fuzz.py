@@ -118,6 +118,23 @@ def test_generator_bug_is_reported_as_an_invalid_scene(tmp_path: Path,
     assert "camera.fov_y" in report.findings[0].detail
 
 
+def test_an_invalid_base_scene_of_a_bad_input_is_a_generator_bug_not_a_loader_finding(
+        tmp_path: Path, monkeypatch: pytest.MonkeyPatch) -> None:
+    """A long run once reported 'film.width: missing required key' for a mutation at lights[2].type:
+    the base scene itself was invalid (a lamp's core radiance past the bound), so the mutation was
+    judged against the wrong field and shrunk to nonsense."""
+    def broken(rng: Any, config: Any = None) -> dict:
+        scene = random_scene(rng, config)
+        scene["camera"]["fov_y"] = 180.0  # outside (0, 180)
+        return scene
+
+    monkeypatch.setattr(harness, "random_scene", broken)
+    report = harness.run(_options(tmp_path, scenes=0, bad_inputs=3, backends=("cpu",)))
+    assert [f.kind for f in report.findings] == ["invalid"]
+    assert report.findings[0].occurrences == 3 and "camera.fov_y" in report.findings[0].detail
+    assert report.bad_inputs == 0
+
+
 def test_loader_message_naming_another_field_is_a_finding(tmp_path: Path,
                                                           monkeypatch: pytest.MonkeyPatch) -> None:
     def misattributed(scene: dict, rng: Any, **kwargs: Any) -> Mutation:

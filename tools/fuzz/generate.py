@@ -369,7 +369,7 @@ def _special_placements(d: _Draw, scene: Scene) -> None:
     if lights and d.config.allows("camera_inside_lamp") and d.chance(0.1):
         light = d.choice(lights)
         light["position"] = [p + 1e-3 * x for p, x in zip(cam["position"], d.unit())]
-        light["radius"] = d.choice([0.01, 1.0, 1e3])
+        light["radius"] = _core_radiance_radius(light["intensity"], d.choice([0.01, 1.0, 1e3]))
     if surfaces and d.chance(0.1):  # the camera inside a box or a sphere
         surface = d.choice(surfaces)
         if surface["type"] == "sphere":

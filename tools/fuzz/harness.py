@@ -462,6 +462,29 @@ def _verdict_kind(verdict: str) -> str:
     return verdict.split(":")[0].split(" ")[0]
 
 
+def _invalid_base(base: Scene, index: int, options: FuzzOptions, recorder: Recorder, report: RunReport,
+                  progress: Progress) -> bool:
+    """True (and an ``invalid`` finding: a generator bug) when the loader refuses the scene a
+    bad input was to be made from; a mutation of it would be judged against the wrong field."""
+    try:
+        airlight.load_scene(base)
+    except (TypeError, ValueError) as exc:
+        problem = Problem("invalid", "-", f"load_scene refused a generated scene: {exc}", type(exc).__name__)
+        report.problems[problem.kind] = report.problems.get(problem.kind, 0) + 1
+        known = recorder.seen(problem, base)
+        if known is not None:
+            known.occurrences += 1
+            recorder.write_index()
+            return True
+        progress.message(f"bad input {index}: its base scene is invalid: {exc}")
+        minimal, attempts = shrink(base, _still_fails(None, problem, options),
+                                   budget_seconds=min(options.shrink_seconds, 60.0))
+        recorder.add(problem, 10_000_000 + index, base, minimal, attempts, problem.detail, ("-",),
+                     options.demo, bad_input=False)
+        return True
+    return False
+
+
 def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, report: RunReport,
             progress: Progress) -> None:
     """The bad-input part of a run: mutations of valid scenes must be refused cleanly."""
@@ -471,6 +494,8 @@ def run_bad(options: FuzzOptions, worker: Worker | None, recorder: Recorder, rep
             break
         rng = scene_rng(options.seed, 10_000_000 + index)
         base = random_scene(rng, options.generator)
+        if _invalid_base(base, index, options, recorder, report, progress):
+            continue
         mutation = mutate(base, rng, empty_key=options.generator.allows("empty_key"))
         verdict = _bad_outcome(worker, mutation, options)
         report.bad_inputs += 1
