@@ -2,7 +2,6 @@
 // called through the integrator's hooks (effect.cmake EFFECT_HOOKS):
 // surface_irradiance, emitter_hit, view_glow, pixel_cores.
 
-
 // Irradiance from the light of a lamp of intensity I scattered once on its way
 // to a surface point at distance dist: sigma_s I / (2 pi D) e^{-T} G(T, theta_s)
 // (effects/lamp_airlight/physics.md section 3), D held at the lamp radius inside the lamp.
@@ -58,8 +57,6 @@ vec3 point_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     }
     return irradiance;
 }
-
-
 
 // Airlight of point light `light` over the visible part [0, x_end] of the
 // view ray (effects/lamp_airlight/physics.md): sigma_s I / (2 pi h) times the segment

@@ -105,14 +105,16 @@ def test_injected_gl_cpu_disagreement_is_found(tmp_path: Path, monkeypatch: pyte
     assert "disagreement" in {f.kind for f in report.findings}
 
 
+def _generator_with_fov_180(rng: Any, config: Any = None) -> dict:
+    """A generator bug: every scene's fov_y is outside (0, 180)."""
+    scene = random_scene(rng, config)
+    scene["camera"]["fov_y"] = 180.0
+    return scene
+
+
 def test_generator_bug_is_reported_as_an_invalid_scene(tmp_path: Path,
                                                        monkeypatch: pytest.MonkeyPatch) -> None:
-    def broken(rng: Any, config: Any = None) -> dict:
-        scene = random_scene(rng, config)
-        scene["camera"]["fov_y"] = 180.0  # outside (0, 180)
-        return scene
-
-    monkeypatch.setattr(harness, "random_scene", broken)
+    monkeypatch.setattr(harness, "random_scene", _generator_with_fov_180)
     report = harness.run(_options(tmp_path, scenes=2, bad_inputs=0, backends=("cpu",)))
     assert [f.kind for f in report.findings] == ["invalid"]
     assert "camera.fov_y" in report.findings[0].detail
@@ -123,12 +125,7 @@ def test_an_invalid_base_scene_of_a_bad_input_is_a_generator_bug_not_a_loader_fi
     """A long run once reported 'film.width: missing required key' for a mutation at lights[2].type:
     the base scene itself was invalid (a lamp's core radiance past the bound), so the mutation was
     judged against the wrong field and shrunk to nonsense."""
-    def broken(rng: Any, config: Any = None) -> dict:
-        scene = random_scene(rng, config)
-        scene["camera"]["fov_y"] = 180.0  # outside (0, 180)
-        return scene
-
-    monkeypatch.setattr(harness, "random_scene", broken)
+    monkeypatch.setattr(harness, "random_scene", _generator_with_fov_180)
     report = harness.run(_options(tmp_path, scenes=0, bad_inputs=3, backends=("cpu",)))
     assert [f.kind for f in report.findings] == ["invalid"]
     assert report.findings[0].occurrences == 3 and "camera.fov_y" in report.findings[0].detail
