@@ -730,6 +730,28 @@ SlabAtmosphere slab_from_species(const shader::SpeciesGpu species[shader::SPECIE
     return atm;
 }
 
+SlabIllumination slab_illumination(const shader::SkyGpu& sky, const RgbD& ground_albedo) {
+    SlabIllumination light;
+    light.ground_albedo = ground_albedo;
+    const glm::dvec3 s = glm::dvec3(sky.sun_direction);
+    if (sky.sun_direction.w > 0.0f && s.y > 0.0) {
+        light.sun_mu = s.y;
+        light.sun_irradiance = {sky.sun_irradiance.x, sky.sun_irradiance.y, sky.sun_irradiance.z};
+    }
+    if (int(sky.zenith_radiance.w) == shader::SKY_NONE) return light;
+    // phi is measured from the sun's horizontal direction (x when it is at the zenith).
+    glm::dvec3 along(s.x, 0.0, s.z);
+    along = glm::length(along) > 1e-9 ? glm::normalize(along) : glm::dvec3(1.0, 0.0, 0.0);
+    const glm::dvec3 across = glm::cross(along, glm::dvec3(0.0, 1.0, 0.0));
+    light.sky_radiance = [sky, along, across](double mu, double phi) {
+        const double h = std::sqrt(std::max(0.0, 1.0 - mu * mu));
+        const glm::dvec3 w = h * (std::cos(phi) * along + std::sin(phi) * across) + glm::dvec3(0.0, mu, 0.0);
+        const double shape = double(shader::sky_shape(sky, glm::vec3(w)));
+        return RgbD{shape * sky.zenith_radiance.x, shape * sky.zenith_radiance.y, shape * sky.zenith_radiance.z};
+    };
+    return light;
+}
+
 std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES_COUNT], int segments,
                                 double max_depth) {
     float top = 0.0f;

@@ -168,6 +168,12 @@ SlabAtmosphere slab_from_species(const shader::SpeciesGpu species[shader::SPECIE
 std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES_COUNT], int segments,
                                 double max_depth);
 
+// The renderer's sky dome and sun (make_sky_gpu) as the solver's light at
+// the top: the sun's s_y and irradiance (when it lights the scene), the sky
+// Lz shape(w) (effects/daytime/sky_math.glsl) with w rebuilt from (mu, phi)
+// about the sun's azimuth; the ground's albedo as given.
+SlabIllumination slab_illumination(const shader::SkyGpu& sky, const RgbD& ground_albedo);
+
 // Gauss-Legendre nodes and weights on (0, 1) (Golub-Welsch, Eigen's
 // symmetric eigensolver); ascending.
 void gauss_legendre_unit(int n, std::vector<double>& nodes, std::vector<double>& weights);
