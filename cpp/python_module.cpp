@@ -218,7 +218,10 @@ py::dict field_to_python(const airlight::MultipleScatteringField& f) {
 }
 
 airlight::SolverOptions solver_options(int streams, int max_fourier_mode, double initial_depth, bool delta_m,
-                                       const std::vector<double>& view_mu, const std::vector<double>& view_phi) {
+                                       const std::vector<double>& view_mu, const std::vector<double>& view_phi,
+                                       double azimuth_tolerance) {
+    if (!(azimuth_tolerance >= 0.0 && azimuth_tolerance < 1.0))
+        throw py::value_error("azimuth_tolerance: must be in [0, 1)");
     if (streams < 2 || streams > 128) throw py::value_error("streams: must be in [2, 128]");
     if (!(initial_depth > 0.0 && initial_depth <= 16.0)) throw py::value_error("initial_depth: must be in (0, 16]");
     for (double v : view_mu)
@@ -232,6 +235,7 @@ airlight::SolverOptions solver_options(int streams, int max_fourier_mode, double
     o.delta_m = delta_m;
     o.view_mu = view_mu;
     o.view_phi = view_phi;
+    o.azimuth_tolerance = azimuth_tolerance;
     return o;
 }
 
@@ -520,7 +524,7 @@ PYBIND11_MODULE(_core, m) {
            const std::vector<std::vector<std::array<double, 3>>>& scattering_depth, double sun_mu,
            const std::array<double, 3>& sun_irradiance, py::object sky, const std::array<double, 3>& ground_albedo,
            int streams, int max_fourier_mode, double initial_depth, bool delta_m, const std::vector<double>& view_mu,
-           const std::vector<double>& view_phi) {
+           const std::vector<double>& view_phi, double azimuth_tolerance) {
             airlight::SlabAtmosphere atm;
             for (const py::object& p : phases) {
                 if (py::isinstance<py::str>(p) && p.cast<std::string>() == "rayleigh") {
@@ -570,21 +574,21 @@ PYBIND11_MODULE(_core, m) {
                     return sky(mu, phi).cast<std::array<double, 3>>();
                 };
             const airlight::SolverOptions o =
-                solver_options(streams, max_fourier_mode, initial_depth, delta_m, view_mu, view_phi);
+                solver_options(streams, max_fourier_mode, initial_depth, delta_m, view_mu, view_phi, azimuth_tolerance);
             return field_to_python(airlight::solve_plane_parallel(atm, light, o));
         },
         py::arg("phases"), py::arg("layer_tops"), py::arg("extinction_depth"), py::arg("scattering_depth"),
         py::arg("sun_mu") = 0.0, py::arg("sun_irradiance") = std::array<double, 3>{0.0, 0.0, 0.0},
         py::arg("sky") = py::none(), py::arg("ground_albedo") = std::array<double, 3>{0.0, 0.0, 0.0},
-        py::arg("streams") = 16, py::arg("max_fourier_mode") = -1, py::arg("initial_depth") = 1.0 / 16.0,
+        py::arg("streams") = 16, py::arg("max_fourier_mode") = -1, py::arg("initial_depth") = 0.25,
         py::arg("delta_m") = true, py::arg("view_mu") = std::vector<double>{},
-        py::arg("view_phi") = std::vector<double>{});
+        py::arg("view_phi") = std::vector<double>{}, py::arg("azimuth_tolerance") = 1e-4);
     m.def(
         "solve_plane_parallel_scene",
         // A scene's atmosphere, sky and sun (slab_from_species, slab_illumination)
         // over the levels slab_levels(segments, max_layer_depth).
         [](py::handle scene_obj, double ground_albedo, int segments, double max_layer_depth, int streams,
-           double initial_depth) {
+           double initial_depth, double azimuth_tolerance) {
             const Scene scene = scene_from_python(scene_obj);
             if (!(ground_albedo >= 0.0 && ground_albedo <= 1.0))
                 throw py::value_error("ground_albedo: must be in [0, 1]");
@@ -596,7 +600,8 @@ PYBIND11_MODULE(_core, m) {
             const airlight::SlabAtmosphere atm = airlight::slab_from_species(species, levels);
             const airlight::SlabIllumination light = airlight::slab_illumination(
                 airlight::make_sky_gpu(scene.sky, scene.sun), {ground_albedo, ground_albedo, ground_albedo});
-            const airlight::SolverOptions o = solver_options(streams, -1, initial_depth, true, {}, {});
+            const airlight::SolverOptions o =
+                solver_options(streams, -1, initial_depth, true, {}, {}, azimuth_tolerance);
             airlight::MultipleScatteringField f;
             {
                 py::gil_scoped_release release;
@@ -607,7 +612,7 @@ PYBIND11_MODULE(_core, m) {
             return d;
         },
         py::arg("scene"), py::arg("ground_albedo") = 0.0, py::arg("segments") = 16, py::arg("max_layer_depth") = 2.0,
-        py::arg("streams") = 16, py::arg("initial_depth") = 1.0 / 16.0);
+        py::arg("streams") = 16, py::arg("initial_depth") = 0.25, py::arg("azimuth_tolerance") = 1e-4);
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

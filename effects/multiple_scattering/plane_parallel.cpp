@@ -502,14 +502,34 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                     }
             }
         }
+        std::vector<double> cos_m(static_cast<size_t>(np)), sin_m(static_cast<size_t>(np));
+        for (int b = 0; b < np; ++b) {
+            cos_m[size_t(b)] = std::cos(m * out.view_phi[size_t(b)]);
+            sin_m[size_t(b)] = std::sin(m * out.view_phi[size_t(b)]);
+        }
         double mode_scale = 0.0;
+        std::vector<std::pair<const LayerOptics*, LayerOperators>> cache;
         for (int c = 0; c < 3; ++c) {
             // Layer operators.
             std::vector<LayerOperators> ops(static_cast<size_t>(layers + 1));
             bool any_scatter = false;
             for (int l = 1; l <= layers; ++l) {
-                ops[size_t(l)] =
-                    layer_operators(optics[size_t(l)][size_t(c)], basis, mu, w, sun ? sun_mu : 0.0, opt.initial_depth);
+                // Layers of equal optics (equal parts of a uniform species, grey
+                // channels) share their operators (cache of this mode).
+                const LayerOptics& lo = optics[size_t(l)][size_t(c)];
+                const LayerOperators* same = nullptr;
+                for (const auto& entry : cache)
+                    if (entry.first->scaled_depth == lo.scaled_depth &&
+                        entry.first->scaled_albedo == lo.scaled_albedo && entry.first->chi == lo.chi) {
+                        same = &entry.second;
+                        break;
+                    }
+                if (same) {
+                    ops[size_t(l)] = *same;
+                } else {
+                    ops[size_t(l)] = layer_operators(lo, basis, mu, w, sun ? sun_mu : 0.0, opt.initial_depth);
+                    cache.emplace_back(&lo, ops[size_t(l)]);
+                }
                 any_scatter = any_scatter || ops[size_t(l)].scatters;
             }
             const double albedo = m == 0 ? light.ground_albedo[size_t(c)] : 0.0;
@@ -610,12 +630,11 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 const Mat wd = Eigen::Map<const Vec>(w.data(), n).asDiagonal() * diffuse_down;
                 for (int i = 0; i < species; ++i) {
                     const Mat kv = 0.5 * (view_same[size_t(i)] * wu + view_opposite[size_t(i)] * wd);
+                    double* dst = &out.phased_radiance[out.phased_index(lev, i, c, 0, 0)];
                     for (int a = 0; a < nv; ++a)
-                        for (int b = 0; b < np; ++b) {
-                            const double phi = out.view_phi[size_t(b)];
-                            out.phased_radiance[out.phased_index(lev, i, c, a, b)] +=
-                                kv(a, 0) * std::cos(m * phi) + kv(a, 1) * std::sin(m * phi);
-                        }
+                        for (int b = 0; b < np; ++b)
+                            dst[size_t(a) * size_t(np) + size_t(b)] +=
+                                kv(a, 0) * cos_m[size_t(b)] + kv(a, 1) * sin_m[size_t(b)];
                 }
             }
         }
@@ -752,15 +771,17 @@ SlabIllumination slab_illumination(const shader::SkyGpu& sky, const RgbD& ground
     return light;
 }
 
+// The top optical depth whose layers are refined (slab_levels).
+constexpr double SUNLIT_DEPTH = 4.0;
+
 std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES_COUNT], int segments,
                                 double max_depth) {
     float top = 0.0f;
     const std::vector<float> base = make_altitude_levels(species, segments, top);
     std::vector<double> levels;
     if (base.empty()) return levels;
-    levels.push_back(double(base[0]));
-    for (size_t k = 1; k < base.size(); ++k) {
-        const double a = base[k - 1], b = base[k];
+    // The densest channel's optical depth between two altitudes.
+    auto depth_between = [&](double a, double b) {
         double depth = 0.0;
         for (int c = 0; c < 3; ++c) {
             double d = 0.0;
@@ -768,25 +789,44 @@ std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES
                 if (species[i].phase.z != 0.0f) d += double(species[i].sigma_t[c]) * column_between(species[i], a, b);
             depth = std::max(depth, d);
         }
-        const int parts = std::max(1, int(std::ceil(depth / max_depth)));
-        // Equal parts in optical depth: bisect the column in altitude.
-        for (int p = 1; p < parts; ++p) {
-            const double target = depth * p / parts;
-            double lo = a, hi = b;
-            for (int it = 0; it < 60; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                double d = 0.0;
-                for (int c = 0; c < 3; ++c) {
-                    double dc = 0.0;
-                    for (int i = 0; i < shader::SPECIES_COUNT; ++i)
-                        if (species[i].phase.z != 0.0f)
-                            dc += double(species[i].sigma_t[c]) * column_between(species[i], a, mid);
-                    d = std::max(d, dc);
-                }
-                (d < target ? lo : hi) = mid;
-            }
-            levels.push_back(0.5 * (lo + hi));
+        return depth;
+    };
+    // The altitude in [a, b] at optical depth `target` above a (bisection).
+    auto altitude_at = [&](double a, double b, double target) {
+        double lo = a, hi = b;
+        for (int it = 0; it < 60; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (depth_between(a, mid) < target ? lo : hi) = mid;
         }
+        return 0.5 * (lo + hi);
+    };
+    std::vector<double> cuts(base.begin(), base.end());
+    // Grading at both boundaries (docs/solver.md section 6): grazing radiance
+    // changes over optical depths of the order of its cosine next to the
+    // ground and the top, so levels are added at depths max_depth / 2^k
+    // (k = 1..10) from each.
+    const double total = depth_between(0.0, double(top));
+    for (int k = 1; k <= 10; ++k) {
+        const double d = max_depth * std::ldexp(1.0, -k);
+        if (d >= 0.5 * total) continue;
+        cuts.push_back(altitude_at(0.0, double(top), d));
+        cuts.push_back(altitude_at(0.0, double(top), total - d));
+    }
+    std::sort(cuts.begin(), cuts.end());
+    cuts.erase(std::unique(cuts.begin(), cuts.end()), cuts.end());
+    levels.push_back(cuts[0]);
+    for (size_t k = 1; k < cuts.size(); ++k) {
+        const double a = cuts[k - 1], b = cuts[k];
+        if (!(b > a)) continue;
+        const double depth = depth_between(a, b);
+        // Where the sun's beam is still strong (the top SUNLIT_DEPTH of the
+        // column), the aureole it scatters varies like C exp(-C / mu0):
+        // layers there are 8 times thinner (docs/solver.md section 6).
+        const double from_top = depth_between(b, double(top));
+        const double limit = from_top < SUNLIT_DEPTH ? max_depth / 8.0 : max_depth;
+        const int parts = std::max(1, int(std::ceil(depth / limit)));
+        // Equal parts in optical depth.
+        for (int p = 1; p < parts; ++p) levels.push_back(altitude_at(a, b, depth * p / parts));
         levels.push_back(b);
     }
     return levels;

@@ -379,18 +379,21 @@ void check_convergence() {
                                         scale);
         return d;
     };
-    const MultipleScatteringField ref = run(48, 1.0 / 16);
+    const double default_depth = SolverOptions{}.initial_depth;
+    const MultipleScatteringField ref = run(48, default_depth);
     double previous = 1e30;
     for (int n : {8, 16, 32}) {
-        const double d = difference(run(n, 1.0 / 16), ref);
+        const double d = difference(run(n, default_depth), ref);
         if (g_print) std::printf("streams %2d: largest difference to 48 streams %.2e (flux, K / max K)\n", n, d);
         CHECK_MSG(d < previous, std::to_string(n));
         previous = d;
         if (n == 16) CHECK_MSG(d < 0.02, std::to_string(d));
     }
     const MultipleScatteringField fine = run(16, 1.0 / 1024);
-    const double d_default = difference(run(16, 1.0 / 16), fine), d_coarse = difference(run(16, 1.0), fine);
-    if (g_print) std::printf("thin layer mu_min/16 vs /1024: %.2e; mu_min vs /1024: %.2e\n", d_default, d_coarse);
+    const double d_default = difference(run(16, default_depth), fine), d_coarse = difference(run(16, 4.0), fine);
+    if (g_print)
+        std::printf("thin layer default (mu_min x %.3g) vs mu_min / 1024: %.2e; 4 mu_min: %.2e\n", default_depth,
+                    d_default, d_coarse);
     CHECK_MSG(d_default < 1e-4, std::to_string(d_default));
     CHECK(d_default < d_coarse);
 }
@@ -521,6 +524,90 @@ void check_finite_sweep() {
     CHECK_MSG(bad == 0, std::to_string(bad) + " of " + std::to_string(runs));
 }
 
+// Interpolation in altitude: the solver's own levels (slab_levels) against a
+// solve with a level added at the middle (in optical depth) of every layer:
+// K there against linear interpolation in the column between the two ends.
+double altitude_interpolation_error(const Atmosphere& atm, double max_depth, bool print_it, const char* name) {
+    shader::SpeciesGpu species[shader::SPECIES_COUNT];
+    make_species_gpu(atm, species);
+    const std::vector<double> levels = slab_levels(species, 16, max_depth);
+    auto green_depth = [&](double a, double b) {
+        const SlabAtmosphere one = slab_from_species(species, {a, b});
+        double d = 0.0;
+        for (const RgbD& t : one.layers[0].extinction_depth) d += t[1];
+        return d;
+    };
+    std::vector<double> refined;
+    for (size_t k = 0; k + 1 < levels.size(); ++k) {
+        refined.push_back(levels[k]);
+        const double half = 0.5 * green_depth(levels[k], levels[k + 1]);
+        double lo = levels[k], hi = levels[k + 1];
+        for (int it = 0; it < 60; ++it) {
+            const double mid = 0.5 * (lo + hi);
+            (green_depth(levels[k], mid) < half ? lo : hi) = mid;
+        }
+        refined.push_back(0.5 * (lo + hi));
+    }
+    refined.push_back(levels.back());
+    SlabIllumination s = sun_only(0.6, 1.0);
+    s.ground_albedo = {0.2, 0.2, 0.2};
+    s.sky_radiance = [](double mu, double) { return RgbD{0.1 * (1 + 2 * mu), 0.1 * (1 + 2 * mu), 0.1 * (1 + 2 * mu)}; };
+    SolverOptions o;
+    o.streams = 12;
+    const MultipleScatteringField f = solve_plane_parallel(slab_from_species(species, refined), s, o);
+    double worst = 0.0, worst_altitude = 0.0, worst_mu = 0.0, worst_depth = 0.0;
+    for (int i = 0; i < f.species_count; ++i) {
+        double scale = 0.0;
+        for (size_t lev = 0; lev < f.altitudes.size(); ++lev)
+            for (size_t a = 0; a < f.view_mu.size(); ++a)
+                for (size_t p = 0; p < f.view_phi.size(); ++p)
+                    scale = std::max(scale, f.phased(int(lev), i, 1, int(a), int(p)));
+        for (size_t lev = 1; lev + 1 < f.altitudes.size(); lev += 2) {
+            const double c0 = f.column[lev - 1][1], c1 = f.column[lev][1], c2 = f.column[lev + 1][1];
+            const double t = (c1 - c0) / (c2 - c0);
+            for (size_t a = 0; a < f.view_mu.size(); ++a)
+                for (size_t p = 0; p < f.view_phi.size(); ++p) {
+                    const double guess = (1 - t) * f.phased(int(lev - 1), i, 1, int(a), int(p)) +
+                                         t * f.phased(int(lev + 1), i, 1, int(a), int(p));
+                    const double e = std::abs(guess - f.phased(int(lev), i, 1, int(a), int(p))) / scale;
+                    if (e > worst) {
+                        worst = e;
+                        worst_altitude = f.altitudes[lev];
+                        worst_mu = f.view_mu[a];
+                        worst_depth = c0 - c2;
+                    }
+                }
+        }
+    }
+    if (print_it)
+        std::printf(
+            "altitude interpolation, %s, layers <= %.2f deep (%zu levels): worst %.2e of the largest K "
+            "(at %.0f m, view mu %.2f, layer depth %.3f)\n",
+            name, max_depth, levels.size(), worst, worst_altitude, worst_mu, worst_depth);
+    return worst;
+}
+
+void check_altitude_interpolation() {
+    Atmosphere clear, rain, fog;
+    clear.molecules.present = rain.molecules.present = fog.molecules.present = true;
+    clear.aerosol.present = rain.aerosol.present = fog.aerosol.present = true;
+    clear.aerosol.visibility = 30000.0f;
+    rain.aerosol.visibility = 3000.0f;
+    rain.rain.present = true;
+    rain.rain.rate = 40.0f;
+    fog.aerosol.visibility = 50.0f;
+    double previous = 1e30;
+    for (double d : {4.0, 2.0, 1.0}) {
+        const double e = std::max({altitude_interpolation_error(clear, d, g_print, "clear"),
+                                   altitude_interpolation_error(rain, d, g_print, "40 mm/h rain"),
+                                   altitude_interpolation_error(fog, d, g_print, "50 m fog")});
+        CHECK_MSG(e < previous, std::to_string(d));
+        previous = e;
+        if (d == 2.0) CHECK_MSG(e < 0.05, std::to_string(e));
+        if (d == 1.0) CHECK_MSG(e < 0.015, std::to_string(e));
+    }
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -535,6 +622,7 @@ int main(int argc, char** argv) {
     check_renderer_atmosphere();
     check_tilted_irradiance();
     check_convergence();
+    check_altitude_interpolation();
     check_finite_sweep();
     return airlight_test::test_result("test_plane_parallel");
 }
