@@ -1,7 +1,8 @@
-// The plane-parallel solver (effects/multiple_scattering/physics.md; docs/solver.md):
-// per channel and azimuth mode, each layer's reflection and transmission by
-// doubling (section 5), the stack by adding from both ends (section 5), the
-// interface fields, then the outputs (section 6, 7).
+// The plane-parallel solver (effects/multiple_scattering/physics.md, design and
+// measurements in effects/multiple_scattering/docs/solver.md): per channel and
+// azimuth mode, each layer's reflection and transmission by doubling and the
+// stack by adding from both ends (effects/multiple_scattering/physics.md
+// section 5), the interface fields, then the outputs (sections 6 and 7).
 #include "plane_parallel.hpp"
 
 #include <Eigen/Dense>
@@ -21,7 +22,7 @@ using Vec = Eigen::VectorXd;
 constexpr double kPi = 3.14159265358979323846;
 
 // Normalised associated Legendre functions Lambda_l^m(x) = sqrt((l-m)!/(l+m)!) P_l^m(x)
-// for l = 0..lmax (0 for l < m), by the upward recurrence (physics.md section 3).
+// for l = 0..lmax (0 for l < m), by the upward recurrence (effects/multiple_scattering/physics.md section 3).
 void normalised_legendre(int m, int lmax, double x, std::vector<double>& out) {
     out.assign(size_t(lmax + 1), 0.0);
     if (m > lmax) return;
@@ -37,7 +38,7 @@ void normalised_legendre(int m, int lmax, double x, std::vector<double>& out) {
     }
 }
 
-// A layer's optics in one channel after delta-M scaling (physics.md section 4).
+// A layer's optics in one channel after delta-M scaling (effects/multiple_scattering/physics.md section 4).
 struct LayerOptics {
     double depth = 0.0;          // tau (true extinction)
     double scaled_depth = 0.0;   // tau* = (1 - omega f) tau
@@ -48,7 +49,7 @@ struct LayerOptics {
 // Reflection R, diffuse transmission Td (T = diag(E) + Td), exact direct
 // transmission E, and the sun's diffuse sources per unit beam irradiance at
 // the layer's top: U upward at the top, D downward at the bottom; t the
-// beam's transmission (physics.md section 5).
+// beam's transmission (effects/multiple_scattering/physics.md section 5).
 struct LayerOperators {
     Mat reflection, diffuse_transmission;
     Vec direct;
@@ -58,7 +59,7 @@ struct LayerOperators {
 };
 
 // Phase mode matrices p^m(+mu_i, +-mu_j) and the beam's p^m(+-mu_i, -mu0)
-// for moments chi (physics.md section 3).
+// for moments chi (effects/multiple_scattering/physics.md section 3).
 struct ModeKernel {
     Mat same, opposite;    // p^m(mu_i, mu_j), p^m(mu_i, -mu_j)
     Vec sun_up, sun_down;  // p^m(mu_i, -mu0), p^m(-mu_i, -mu0)
@@ -103,7 +104,7 @@ ModeKernel mode_kernel(const ModeBasis& b, const std::vector<double>& chi, bool 
 }
 
 // One homogeneous layer: a thin layer of depth tau* / 2^n by the diamond
-// scheme, then n doublings (physics.md section 5).
+// scheme, then n doublings (effects/multiple_scattering/physics.md section 5).
 LayerOperators layer_operators(const LayerOptics& lo, const ModeBasis& b, const std::vector<double>& mu,
                                const std::vector<double>& w, double sun_mu, double initial_depth) {
     const int n = b.n;
@@ -131,7 +132,7 @@ LayerOperators layer_operators(const LayerOptics& lo, const ModeBasis& b, const 
     const double thin = std::max(initial_depth * mu[0], 1e-300);
     if (tau > thin) doublings = int(std::ceil(std::log2(tau / thin)));
     const double delta = std::ldexp(tau, -doublings);
-    // Thin layer, diamond scheme (section 5.2): a = delta/2 M^-1 (1 - c P++ W),
+    // Thin layer, diamond scheme (effects/multiple_scattering/physics.md section 5.2): a = delta/2 M^-1 (1 - c P++ W),
     // b = delta/2 M^-1 c P+- W with c = omega*/2.
     const double c = 0.5 * lo.scaled_albedo;
     Mat a(n, n), bm(n, n);
@@ -152,7 +153,7 @@ LayerOperators layer_operators(const LayerOptics& lo, const ModeBasis& b, const 
     for (int i = 0; i < n; ++i) {
         // The direct part is what the scheme gives without scattering,
         // (1 - s)/(1 + s) ~ exp(-2 s): kept (not the exact exponential) so
-        // that the thin layer conserves energy exactly (section 5.2).
+        // that the thin layer conserves energy exactly (effects/multiple_scattering/physics.md section 5.2).
         const double s = 0.5 * delta / mu[size_t(i)];
         e(i) = (1.0 - s) / (1.0 + s);
         td(i, i) -= e(i);
@@ -175,7 +176,7 @@ LayerOperators layer_operators(const LayerOptics& lo, const ModeBasis& b, const 
         d = y.tail(n);
         t = std::exp(-delta / sun_mu);
     }
-    // Doubling (section 5.3).
+    // Doubling (effects/multiple_scattering/physics.md section 5.3).
     for (int it = 0; it < doublings; ++it) {
         const Mat rr = r * r;
         Eigen::PartialPivLU<Mat> q(id - rr);
@@ -235,7 +236,9 @@ PhaseFunction PhaseFunction::legendre(std::vector<double> moments) {
 double PhaseFunction::moment(int l) const {
     switch (kind) {
         case Kind::rayleigh:
-            return l == 0 ? 1.0 : (l == 2 ? 0.1 : 0.0);  // p = 3/4 (1 + c^2) (section 2)
+            return l == 0
+                       ? 1.0
+                       : (l == 2 ? 0.1 : 0.0);  // p = 3/4 (1 + c^2) (effects/multiple_scattering/physics.md section 2)
         case Kind::henyey_greenstein:
             return std::pow(g, l);
         case Kind::legendre:
@@ -311,7 +314,8 @@ double MultipleScatteringField::node_diffuse_radiance(int level, int channel, in
 }
 
 double MultipleScatteringField::tilted_irradiance_sh(int level, int channel, const std::array<double, 3>& n) const {
-    // Clamped-cosine convolution: A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4 (section 7).
+    // Clamped-cosine convolution: A_0 = pi, A_1 = 2 pi / 3, A_2 = pi / 4 (effects/multiple_scattering/physics.md
+    // section 7).
     const std::array<double, 9> y = sh_basis(n);
     const double a[9] = {kPi,       2.0 * kPi / 3.0, 2.0 * kPi / 3.0, 2.0 * kPi / 3.0, kPi / 4.0,
                          kPi / 4.0, kPi / 4.0,       kPi / 4.0,       kPi / 4.0};
@@ -334,7 +338,7 @@ double MultipleScatteringField::tilted_irradiance_nodes(int level, int channel, 
                 e += node_weight[size_t(j)] * 2.0 * kPi / az * c * node_diffuse_radiance(level, channel, node, phi);
         }
     }
-    // The forward peak's residual beam (section 6) along the sun.
+    // The forward peak's residual beam (effects/multiple_scattering/physics.md section 6) along the sun.
     const std::array<double, 3> s = look_direction(sun_mu, 0.0);
     const double c = s[0] * n[0] + s[1] * n[1] + s[2] * n[2];
     if (sun_mu > 0.0 && c > 0.0) e += sun_forward_irradiance[size_t(level)][size_t(channel)] * c;
@@ -378,7 +382,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     altitude_top_down[0] = layers > 0 ? atm.layers.back().top : 0.0;
     for (int l = 1; l <= layers; ++l) altitude_top_down[size_t(l)] = layer_of(l).bottom;
 
-    // Optics per layer and channel (section 4).
+    // Optics per layer and channel (effects/multiple_scattering/physics.md section 4).
     std::vector<std::array<LayerOptics, 3>> optics(static_cast<size_t>(layers + 1));
     std::vector<RgbD> depth_true(size_t(levels), RgbD{}), depth_scaled(size_t(levels), RgbD{});
     for (int l = 1; l <= layers; ++l) {
@@ -446,7 +450,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     out.sun_forward_irradiance.assign(size_t(levels), RgbD{});
     out.radiance_sh.assign(size_t(levels), {});
 
-    // The forward peak's residual beam (section 6) and the unscattered light.
+    // The forward peak's residual beam (effects/multiple_scattering/physics.md section 6) and the unscattered light.
     for (int k = 0; k < levels; ++k)
         for (int c = 0; c < 3; ++c) {
             const int lev = layers - k;
@@ -483,7 +487,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
         basis.node.resize(size_t(n));
         for (int j = 0; j < n; ++j) normalised_legendre(m, lmax, mu[size_t(j)], basis.node[size_t(j)]);
         if (sun) normalised_legendre(m, lmax, -sun_mu, basis.sun);
-        // View kernels p_i^m(u_a, +-mu_j) with the species' own moments (section 6).
+        // View kernels p_i^m(u_a, +-mu_j) with the species' own moments (effects/multiple_scattering/physics.md section
+        // 6).
         std::vector<Mat> view_same(static_cast<size_t>(species)), view_opposite(static_cast<size_t>(species));
         std::vector<std::vector<double>> view_lambda(static_cast<size_t>(nv));
         for (int a = 0; a < nv; ++a) normalised_legendre(m, lmax, -out.view_mu[size_t(a)], view_lambda[size_t(a)]);
@@ -541,7 +546,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             std::vector<double> beta(size_t(levels), 0.0);  // beam irradiance (normal) at interface k, scaled depth
             for (int k = 0; k < levels; ++k)
                 beta[size_t(k)] = e_sun * std::exp(-depth_scaled[size_t(k)][size_t(c)] / std::max(sun_mu, 1e-300));
-            // Top-down adding (section 5.4): Rb reflection of the stack above
+            // Top-down adding (effects/multiple_scattering/physics.md section 5.4): Rb reflection of the stack above
             // for light from below; Sdown the downward light with nothing from
             // below, its unscattered part unsc and its diffuse part sd.
             std::vector<Mat> rb(static_cast<size_t>(levels)), sdown(static_cast<size_t>(levels)),
@@ -579,7 +584,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             ru[size_t(layers)] = Mat::Zero(n, n);
             sup[size_t(layers)] = Mat::Zero(n, 2);
             if (albedo > 0.0) {
-                // Lambert: I+ = A / pi x (2 pi sum_j w_j mu_j I-_j + mu0 beam) (section 5.1).
+                // Lambert: I+ = A / pi x (2 pi sum_j w_j mu_j I-_j + mu0 beam) (effects/multiple_scattering/physics.md
+                // section 5.1).
                 for (int i = 0; i < n; ++i)
                     for (int j = 0; j < n; ++j) ru[size_t(layers)](i, j) = 2.0 * albedo * w[size_t(j)] * mu[size_t(j)];
                 if (sun) sup[size_t(layers)].col(0).setConstant(albedo / kPi * sun_mu * beta[size_t(layers)]);
@@ -595,7 +601,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 sup[size_t(k - 1)] = t * h.solve(src);
                 if (sun) sup[size_t(k - 1)].col(0) += op.sun_up * beta[size_t(k - 1)];
             }
-            // Interface fields (section 5.4) and the outputs.
+            // Interface fields (effects/multiple_scattering/physics.md section 5.4) and the outputs.
             for (int k = 0; k < levels; ++k) {
                 const int lev = layers - k;
                 Eigen::PartialPivLU<Mat> f(id - rb[size_t(k)] * ru[size_t(k)]);
@@ -603,7 +609,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 const Mat up = ru[size_t(k)] * down + sup[size_t(k)];
                 Mat diffuse_down =
                     sd[size_t(k)] + f.solve(rb[size_t(k)] * (ru[size_t(k)] * sdown[size_t(k)] + sup[size_t(k)]));
-                // The sky's forward-peak residual (section 6).
+                // The sky's forward-peak residual (effects/multiple_scattering/physics.md section 6).
                 const double tt = depth_true[size_t(k)][size_t(c)], ts = depth_scaled[size_t(k)][size_t(c)];
                 if (tt > ts)
                     for (int j = 0; j < n; ++j)
@@ -625,7 +631,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                         fd + sun_mu * out.sun_forward_irradiance[size_t(lev)][size_t(c)];
                     out.irradiance_up[size_t(lev)][size_t(c)] = fu;
                 }
-                // K_i^m(u_a) = 1/2 sum_j w_j [p^m(u, mu_j) I+_j + p^m(u, -mu_j) I-_j] (section 6).
+                // K_i^m(u_a) = 1/2 sum_j w_j [p^m(u, mu_j) I+_j + p^m(u, -mu_j) I-_j]
+                // (effects/multiple_scattering/physics.md section 6).
                 const Mat wu = Eigen::Map<const Vec>(w.data(), n).asDiagonal() * up;
                 const Mat wd = Eigen::Map<const Vec>(w.data(), n).asDiagonal() * diffuse_down;
                 for (int i = 0; i < species; ++i) {
@@ -639,7 +646,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             }
         }
         modes_solved = m + 1;
-        // Azimuth convergence (section 3): two modes in a row below the tolerance.
+        // Azimuth convergence (effects/multiple_scattering/physics.md section 3): two modes in a row below the
+        // tolerance.
         if (m == 0)
             mode0_scale = mode_scale;
         else {
@@ -649,7 +657,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     }
     out.modes_solved = modes_solved;
 
-    // The sun's forward-peak residual scattered by each species' full phase (section 6).
+    // The sun's forward-peak residual scattered by each species' full phase (effects/multiple_scattering/physics.md
+    // section 6).
     if (sun)
         for (int lev = 0; lev < levels; ++lev)
             for (int i = 0; i < species; ++i)
@@ -667,7 +676,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                         }
                 }
 
-    // Spherical harmonics l <= 2 of the diffuse radiance (section 7): modes 0..2
+    // Spherical harmonics l <= 2 of the diffuse radiance (effects/multiple_scattering/physics.md section 7): modes 0..2
     // are the only ones they see; 16 azimuths integrate them exactly.
     const int az = 16;
     for (int lev = 0; lev < levels; ++lev)
@@ -699,7 +708,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
 
 namespace {
 
-// integral_a^b of a profile piece rho = v exp(-(y - s) k) (section 8).
+// integral_a^b of a profile piece rho = v exp(-(y - s) k) (effects/multiple_scattering/physics.md section 8).
 double piece_integral(double v, double s, double k, double a, double b) {
     if (!(b > a) || v == 0.0) return 0.0;
     if (k == 0.0) return v * (b - a);
@@ -801,7 +810,7 @@ std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES
         return 0.5 * (lo + hi);
     };
     std::vector<double> cuts(base.begin(), base.end());
-    // Grading at both boundaries (docs/solver.md section 6): grazing radiance
+    // Grading at both boundaries (effects/multiple_scattering/docs/solver.md section 6): grazing radiance
     // changes over optical depths of the order of its cosine next to the
     // ground and the top, so levels are added at depths max_depth / 2^k
     // (k = 1..10) from each.
@@ -821,7 +830,7 @@ std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES
         const double depth = depth_between(a, b);
         // Where the sun's beam is still strong (the top SUNLIT_DEPTH of the
         // column), the aureole it scatters varies like C exp(-C / mu0):
-        // layers there are 8 times thinner (docs/solver.md section 6).
+        // layers there are 8 times thinner (effects/multiple_scattering/docs/solver.md section 6).
         const double from_top = depth_between(b, double(top));
         const double limit = from_top < SUNLIT_DEPTH ? max_depth / 8.0 : max_depth;
         const int parts = std::max(1, int(std::ceil(depth / limit)));

@@ -24,7 +24,7 @@ namespace airlight {
 using RgbD = std::array<double, 3>;
 
 // A species' phase function p(cos theta), normalised to 4 pi over the sphere,
-// and its Legendre moments chi_l (p = sum (2l+1) chi_l P_l; physics.md section 2).
+// and its Legendre moments chi_l (p = sum (2l+1) chi_l P_l; effects/multiple_scattering/physics.md section 2).
 struct PhaseFunction {
     enum class Kind { rayleigh, henyey_greenstein, legendre };
     Kind kind = Kind::henyey_greenstein;
@@ -71,10 +71,10 @@ struct SolverOptions {
     int max_fourier_mode = -1;        // highest azimuth mode (-1: 2N - 1)
     double azimuth_tolerance = 1e-4;  // stop after two modes below this share of mode 0
     double initial_depth = 0.25;      // thin layer's depth, in units of the smallest ordinate
-    bool delta_m = true;              // delta-M scaling (physics.md section 4)
+    bool delta_m = true;              // delta-M scaling (effects/multiple_scattering/physics.md section 4)
     int sky_azimuth_samples = 96;     // trapezoid nodes of the sky's Fourier transform
     // The output's view grid (look directions): cosines in [-1, 1] and
-    // azimuths from the sun in [0, 2 pi). Empty: defaults (solver.md).
+    // azimuths from the sun in [0, 2 pi). Empty: 33 cosines (uniform in elevation) x 36 azimuths.
     std::vector<double> view_mu, view_phi;
 };
 
@@ -82,7 +82,7 @@ struct SolverOptions {
 // light but the sun's direct beam and the sky's unscattered light, both
 // attenuated with the true optical depth (what the renderer computes itself):
 // light scattered by the air at least once, or reflected by the ground
-// (physics.md section 6).
+// (effects/multiple_scattering/physics.md section 6).
 struct MultipleScatteringField {
     int species_count = 0;
     int streams = 0;                           // N ordinates per hemisphere
@@ -95,7 +95,7 @@ struct MultipleScatteringField {
     std::vector<double> node_mu, node_weight;  // the ordinates on (0, 1] and their weights
 
     // K_i(y, d) = 1/(4 pi) int p_i(d . w) L_diffuse(y, w) dw for look
-    // direction d (physics.md section 6): the renderer's multiple-scattering
+    // direction d (effects/multiple_scattering/physics.md section 6): the renderer's multiple-scattering
     // source is J_ms = sum_i sigma_s,i rho_i(y) K_i (radiance per metre).
     // Index: phased_index(level, species, channel, mu, phi).
     std::vector<double> phased_radiance;
@@ -104,7 +104,7 @@ struct MultipleScatteringField {
     std::vector<RgbD> irradiance_down, irradiance_up;
     // The unscattered light the renderer adds itself, onto a surface facing up.
     std::vector<RgbD> sun_direct_irradiance, sky_direct_irradiance;
-    // The forward-peak residual beam along the sun (physics.md section 6):
+    // The forward-peak residual beam along the sun (effects/multiple_scattering/physics.md section 6):
     // E_sun (exp(-tau*/mu0) - exp(-tau/mu0)), irradiance on a plane facing the
     // sun; part of the diffuse light (in irradiance_down, radiance_sh and
     // phased_radiance, not in node_radiance).
@@ -138,7 +138,7 @@ struct MultipleScatteringField {
     // The diffuse radiance at ordinate `node` (see node_radiance) and azimuth phi.
     double node_diffuse_radiance(int level, int channel, int node, double phi) const;
     // Diffuse irradiance onto a surface of unit normal n (frame of radiance_sh)
-    // from the l <= 2 harmonics (physics.md section 7).
+    // from the l <= 2 harmonics (effects/multiple_scattering/physics.md section 7).
     double tilted_irradiance_sh(int level, int channel, const std::array<double, 3>& normal) const;
     // The same by quadrature of the ordinates' radiance (the reference for the
     // harmonics' error; cost 2N x 4 modes x azimuths).

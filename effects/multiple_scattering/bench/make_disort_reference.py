@@ -1,5 +1,5 @@
 """Writes effects/multiple_scattering/tests/disort_reference.json: PythonicDISORT's
-fluxes and radiances for the comparison cases (tests/disort_cases.py), so that
+fluxes and radiances for the comparison cases (effects/multiple_scattering/tests/disort_cases.py), so that
 test_plane_parallel_solver.py compares against them without PythonicDISORT.
 
     .venv/bin/pip install PythonicDISORT   # 1.8; numpy and scipy only
