@@ -350,6 +350,12 @@ void check_azimuth_mirror() {
             }
     CHECK_MSG(worst < 1e-10, std::to_string(worst));
     CHECK_MSG(asym > 0.05, std::to_string(asym));  // the sky's asymmetry is there to mirror
+    // And the orientation: sky a is brightest at phi = 90 degrees, so the
+    // forward-scattering species' K at the ground looking up that way exceeds
+    // K looking up at phi = 270 degrees (view_phi has 36 steps of 10 degrees).
+    const int up = int(fa.view_mu.size()) * 3 / 4;
+    CHECK_MSG(fa.phased(0, 0, 1, up, 9) > 1.2 * fa.phased(0, 0, 1, up, 27),
+              std::to_string(fa.phased(0, 0, 1, up, 9)) + " " + std::to_string(fa.phased(0, 0, 1, up, 27)));
 }
 
 // Convergence: in the streams (against 48) and in the thin layer's depth.
