@@ -580,7 +580,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("phases"), py::arg("layer_tops"), py::arg("extinction_depth"), py::arg("scattering_depth"),
         py::arg("sun_mu") = 0.0, py::arg("sun_irradiance") = std::array<double, 3>{0.0, 0.0, 0.0},
         py::arg("sky") = py::none(), py::arg("ground_albedo") = std::array<double, 3>{0.0, 0.0, 0.0},
-        py::arg("streams") = 16, py::arg("max_fourier_mode") = -1, py::arg("initial_depth") = 0.25,
+        py::arg("streams") = 16, py::arg("max_fourier_mode") = -1, py::arg("initial_depth") = 1.0 / 16.0,
         py::arg("delta_m") = true, py::arg("view_mu") = std::vector<double>{},
         py::arg("view_phi") = std::vector<double>{}, py::arg("azimuth_tolerance") = 1e-4);
     m.def(
@@ -612,7 +612,7 @@ PYBIND11_MODULE(_core, m) {
             return d;
         },
         py::arg("scene"), py::arg("ground_albedo") = 0.0, py::arg("segments") = 16, py::arg("max_layer_depth") = 2.0,
-        py::arg("streams") = 16, py::arg("initial_depth") = 0.25, py::arg("azimuth_tolerance") = 1e-4);
+        py::arg("streams") = 16, py::arg("initial_depth") = 1.0 / 16.0, py::arg("azimuth_tolerance") = 1e-4);
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

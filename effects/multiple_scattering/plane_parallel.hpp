@@ -70,7 +70,7 @@ struct SolverOptions {
     int streams = 16;                 // N: ordinates per hemisphere (2N in all)
     int max_fourier_mode = -1;        // highest azimuth mode (-1: 2N - 1)
     double azimuth_tolerance = 1e-4;  // stop after two modes below this share of mode 0
-    double initial_depth = 0.25;      // thin layer's depth, in units of the smallest ordinate
+    double initial_depth = 1.0 / 16;  // thin layer's depth, in units of the smallest ordinate
     bool delta_m = true;              // delta-M scaling (effects/multiple_scattering/physics.md section 4)
     int sky_azimuth_samples = 96;     // trapezoid nodes of the sky's Fourier transform
     // The output's view grid (look directions): cosines in [-1, 1] and

@@ -53,7 +53,8 @@ def interpolation() -> None:
                 for j in range(a + 1, b):
                     t = (c[j] - c[a]) / (c[b] - c[a])
                     guess = (1 - t) * k[a] + t * k[b]
-                    lg = np.exp((1 - t) * np.log(np.maximum(k[a], 1e-300)) + t * np.log(np.maximum(k[b], 1e-300)))
+                    la, lb = np.log(np.maximum(k[a], 1e-300)), np.log(np.maximum(k[b], 1e-300))
+                    lg = np.exp((1 - t) * la + t * lb)
                     lin = max(lin, float(np.max(np.abs(guess - k[j]) / scale)))
                     logl = max(logl, float(np.max(np.abs(lg - k[j]) / scale)))
             spacing = max(c[a] - c[b] for a, b in zip(kept[:-1], kept[1:]))
@@ -65,7 +66,7 @@ def main() -> None:
     ap.add_argument("--repeat", type=int, default=3)
     ap.add_argument("--streams", type=int, nargs="*", default=[8, 12, 16, 24, 32])
     ap.add_argument("--reference", type=int, default=48)
-    ap.add_argument("--initial-depth", type=float, default=0.25)
+    ap.add_argument("--initial-depth", type=float, default=1.0 / 16.0)
     ap.add_argument("--interpolation", action="store_true",
                     help="also measure interpolating K between interfaces (solver.md section 6)")
     args = ap.parse_args()
