@@ -10,6 +10,7 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
+#include <thread>
 
 #include "sky.hpp"
 
@@ -512,9 +513,12 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             cos_m[size_t(b)] = std::cos(m * out.view_phi[size_t(b)]);
             sin_m[size_t(b)] = std::sin(m * out.view_phi[size_t(b)]);
         }
-        double mode_scale = 0.0;
-        std::vector<std::pair<const LayerOptics*, LayerOperators>> cache;
-        for (int c = 0; c < 3; ++c) {
+        // The channels are independent: one thread each when allowed, each
+        // writing only its own channel's outputs.
+        using Cache = std::vector<std::pair<const LayerOptics*, LayerOperators>>;
+        double channel_scale[3] = {0.0, 0.0, 0.0};
+        auto solve_channel = [&](int c, Cache& cache) {
+            double& mode_scale = channel_scale[c];
             // Layer operators.
             std::vector<LayerOperators> ops(static_cast<size_t>(layers + 1));
             bool any_scatter = false;
@@ -540,8 +544,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             const double albedo = m == 0 ? light.ground_albedo[size_t(c)] : 0.0;
             const bool sky_mode = sky[size_t(m)][size_t(c)].cwiseAbs().maxCoeff() > 0.0;
             const bool residual = depth_true[size_t(layers)][size_t(c)] > depth_scaled[size_t(layers)][size_t(c)];
-            if (!any_scatter && albedo == 0.0 && !(residual && sky_mode)) continue;  // nothing diffuse in this mode
-            if (!any_scatter && !sky_mode && !sun) continue;
+            if (!any_scatter && albedo == 0.0 && !(residual && sky_mode)) return;  // nothing diffuse in this mode
+            if (!any_scatter && !sky_mode && !sun) return;
             const double e_sun = sun ? light.sun_irradiance[size_t(c)] : 0.0;
             std::vector<double> beta(size_t(levels), 0.0);  // beam irradiance (normal) at interface k, scaled depth
             for (int k = 0; k < levels; ++k)
@@ -644,7 +648,17 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                                 kv(a, 0) * cos_m[size_t(b)] + kv(a, 1) * sin_m[size_t(b)];
                 }
             }
+        };
+        if (opt.threads > 1) {
+            Cache caches[3];
+            std::vector<std::thread> pool;
+            for (int c = 0; c < 3; ++c) pool.emplace_back(solve_channel, c, std::ref(caches[c]));
+            for (std::thread& t : pool) t.join();
+        } else {
+            Cache cache;  // shared: grey channels reuse each other's layers
+            for (int c = 0; c < 3; ++c) solve_channel(c, cache);
         }
+        const double mode_scale = std::max({channel_scale[0], channel_scale[1], channel_scale[2]});
         modes_solved = m + 1;
         // Azimuth convergence (effects/multiple_scattering/physics.md section 3): two modes in a row below the
         // tolerance.

@@ -73,6 +73,7 @@ struct SolverOptions {
     double initial_depth = 1.0 / 16;  // thin layer's depth, in units of the smallest ordinate
     bool delta_m = true;              // delta-M scaling (effects/multiple_scattering/physics.md section 4)
     int sky_azimuth_samples = 96;     // trapezoid nodes of the sky's Fourier transform
+    int threads = 1;                  // > 1: the three channels on their own threads
     // The output's view grid (look directions): cosines in [-1, 1] and
     // azimuths from the sun in [0, 2 pi). Empty: 33 cosines (uniform in elevation) x 36 azimuths.
     std::vector<double> view_mu, view_phi;
