@@ -141,8 +141,8 @@ struct MultipleScatteringField {
     // Diffuse irradiance onto a surface of unit normal n (frame of radiance_sh)
     // from the l <= 2 harmonics (effects/multiple_scattering/physics.md section 7).
     double tilted_irradiance_sh(int level, int channel, const std::array<double, 3>& normal) const;
-    // The same by quadrature of the ordinates' radiance (the reference for the
-    // harmonics' error; cost 2N x 4 modes x azimuths).
+    // The same by quadrature of the ordinates' radiance over 256 azimuths (the
+    // reference for the harmonics' error; exact up to the ordinates).
     double tilted_irradiance_nodes(int level, int channel, const std::array<double, 3>& normal) const;
 };
 

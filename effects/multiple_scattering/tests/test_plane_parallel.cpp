@@ -472,6 +472,11 @@ void check_renderer_atmosphere() {
                     a.layers.size(), b.layers.size(), worst, layering, fa.solve_seconds);
     CHECK_MSG(worst < 5e-3, std::to_string(worst));
     CHECK_MSG(layering < 2e-3, std::to_string(layering));
+    // Threads over the channels give the same numbers.
+    SolverOptions threaded;
+    threaded.threads = 3;
+    const MultipleScatteringField ft = solve_plane_parallel(a, s, threaded);
+    CHECK(ft.phased_radiance == fa.phased_radiance && ft.node_radiance == fa.node_radiance);
 }
 
 // Tilted surfaces: the l <= 2 harmonics against quadrature of the ordinates.
