@@ -110,9 +110,10 @@ struct MultipleScatteringField {
     // sun; part of the diffuse light (in irradiance_down, radiance_sh and
     // phased_radiance, not in node_radiance).
     std::vector<RgbD> sun_forward_irradiance;
-    // Real spherical harmonics (l <= 2, index l (l + 1) + m, sh_basis) of the
-    // diffuse radiance over look directions, in the frame of look_direction:
-    // [level][channel][9].
+    // Real spherical harmonics (l <= 2, index l (l + 1) + m: the standard real
+    // basis in the x, y, z of look_direction's frame, sh_basis) of the diffuse
+    // radiance over look directions, the residual beam included:
+    // [level][channel][9]. Irradiance of any normal: tilted_irradiance_sh.
     std::vector<std::array<std::array<double, 9>, 3>> radiance_sh;
     // The diffuse radiance at the ordinates, Fourier coefficients in azimuth:
     // index node_index(level, channel, mode, node, sine); node 0..N-1 look
@@ -164,8 +165,10 @@ SlabAtmosphere slab_from_species(const shader::SpeciesGpu species[shader::SPECIE
                                  const std::vector<double>& levels);
 
 // Levels for the solver: the renderer's altitude levels (make_altitude_levels
-// with `segments`), each layer split into equal parts so that none is
-// optically thicker than max_depth in its densest channel.
+// with `segments`), plus levels at optical depths max_depth / 2^k (k = 1..10)
+// from the ground and the top, each layer then split into equal parts so that
+// none is optically thicker than max_depth (max_depth / 8 in the top 4
+// optical depths) in its densest channel (effects/multiple_scattering/physics.md section 8).
 std::vector<double> slab_levels(const shader::SpeciesGpu species[shader::SPECIES_COUNT], int segments,
                                 double max_depth);
 
