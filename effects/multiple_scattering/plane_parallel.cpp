@@ -370,9 +370,9 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     out.view_mu = opt.view_mu;
     out.view_phi = opt.view_phi;
     if (out.view_mu.empty())
-        for (int k = 0; k <= 32; ++k) out.view_mu.push_back(std::sin(-0.5 * kPi + kPi * k / 32.0));
+        for (int k = 0; k <= 64; ++k) out.view_mu.push_back(std::sin(-0.5 * kPi + kPi * k / 64.0));
     if (out.view_phi.empty())
-        for (int k = 0; k < 36; ++k) out.view_phi.push_back(2.0 * kPi * k / 36.0);
+        for (int k = 0; k < 72; ++k) out.view_phi.push_back(2.0 * kPi * k / 72.0);
     const int nv = int(out.view_mu.size()), np = int(out.view_phi.size());
 
     // Interfaces from the top (k = 0) down to the ground (k = layers); layer
