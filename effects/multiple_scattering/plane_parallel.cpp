@@ -673,22 +673,26 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
 
     // The sun's forward-peak residual scattered by each species' full phase (effects/multiple_scattering/physics.md
     // section 6).
-    if (sun)
-        for (int lev = 0; lev < levels; ++lev)
-            for (int i = 0; i < species; ++i)
+    if (sun) {
+        // p_i(d . s) / (4 pi) on the view grid, once per species.
+        const std::array<double, 3> s = look_direction(sun_mu, 0.0);
+        std::vector<double> phase_sun(size_t(nv) * size_t(np));
+        for (int i = 0; i < species; ++i) {
+            for (int a = 0; a < nv; ++a)
+                for (int b = 0; b < np; ++b) {
+                    const std::array<double, 3> d = look_direction(out.view_mu[size_t(a)], out.view_phi[size_t(b)]);
+                    phase_sun[size_t(a) * size_t(np) + size_t(b)] =
+                        atm.phases[size_t(i)].value(d[0] * s[0] + d[1] * s[1] + d[2] * s[2]) / (4.0 * kPi);
+                }
+            for (int lev = 0; lev < levels; ++lev)
                 for (int c = 0; c < 3; ++c) {
                     const double res = out.sun_forward_irradiance[size_t(lev)][size_t(c)];
                     if (res == 0.0) continue;
-                    for (int a = 0; a < nv; ++a)
-                        for (int b = 0; b < np; ++b) {
-                            const std::array<double, 3> d =
-                                look_direction(out.view_mu[size_t(a)], out.view_phi[size_t(b)]);
-                            const std::array<double, 3> s = look_direction(sun_mu, 0.0);
-                            const double cs = d[0] * s[0] + d[1] * s[1] + d[2] * s[2];
-                            out.phased_radiance[out.phased_index(lev, i, c, a, b)] +=
-                                atm.phases[size_t(i)].value(cs) * res / (4.0 * kPi);
-                        }
+                    double* dst = &out.phased_radiance[out.phased_index(lev, i, c, 0, 0)];
+                    for (size_t k = 0; k < phase_sun.size(); ++k) dst[k] += phase_sun[k] * res;
                 }
+        }
+    }
 
     // Spherical harmonics l <= 2 of the diffuse radiance (effects/multiple_scattering/physics.md section 7): modes 0..2
     // are the only ones they see; 16 azimuths integrate them exactly.
