@@ -22,8 +22,10 @@
 #include "airlight/scene_io.hpp"
 #include "airlight_tables.hpp"
 #include "phase_tables.hpp"
+#include "plane_parallel.hpp"
 #include "rainbow.hpp"
 #include "scene_json.hpp"
+#include "sky.hpp"
 #include "spot_tables.hpp"
 #include "tables.hpp"
 
@@ -172,6 +174,69 @@ airlight::Image image_from_numpy(const py::array_t<float, py::array::c_style | p
     image.width = int(a.shape(1));
     image.rgb.assign(a.data(), a.data() + a.size());
     return image;
+}
+
+// The multiple-scattering solver's result as numpy arrays
+// (effects/multiple_scattering/plane_parallel.hpp names the fields).
+py::dict field_to_python(const airlight::MultipleScatteringField& f) {
+    const auto levels = py::ssize_t(f.altitudes.size());
+    auto vec = [](const std::vector<double>& v) { return py::array_t<double>(py::ssize_t(v.size()), v.data()); };
+    auto rgb = [&](const std::vector<airlight::RgbD>& v) {
+        py::array_t<double> a({levels, py::ssize_t(3)});
+        std::memcpy(a.mutable_data(), v.data(), v.size() * sizeof(airlight::RgbD));
+        return a;
+    };
+    py::dict d;
+    d["altitudes"] = vec(f.altitudes);
+    d["column"] = rgb(f.column);
+    d["view_mu"] = vec(f.view_mu);
+    d["view_phi"] = vec(f.view_phi);
+    d["node_mu"] = vec(f.node_mu);
+    d["node_weight"] = vec(f.node_weight);
+    py::array_t<double> phased({levels, py::ssize_t(f.species_count), py::ssize_t(3), py::ssize_t(f.view_mu.size()),
+                                py::ssize_t(f.view_phi.size())});
+    std::memcpy(phased.mutable_data(), f.phased_radiance.data(), f.phased_radiance.size() * sizeof(double));
+    d["phased_radiance"] = phased;
+    py::array_t<double> nodes(
+        {levels, py::ssize_t(3), py::ssize_t(f.fourier_modes), py::ssize_t(2 * f.streams), py::ssize_t(2)});
+    std::memcpy(nodes.mutable_data(), f.node_radiance.data(), f.node_radiance.size() * sizeof(double));
+    d["node_radiance"] = nodes;
+    d["irradiance_down"] = rgb(f.irradiance_down);
+    d["irradiance_up"] = rgb(f.irradiance_up);
+    d["sun_direct_irradiance"] = rgb(f.sun_direct_irradiance);
+    d["sky_direct_irradiance"] = rgb(f.sky_direct_irradiance);
+    d["sun_forward_irradiance"] = rgb(f.sun_forward_irradiance);
+    py::array_t<double> sh({levels, py::ssize_t(3), py::ssize_t(9)});
+    std::memcpy(sh.mutable_data(), f.radiance_sh.data(), f.radiance_sh.size() * sizeof(f.radiance_sh[0]));
+    d["radiance_sh"] = sh;
+    d["incident_flux"] = py::make_tuple(f.incident_flux[0], f.incident_flux[1], f.incident_flux[2]);
+    d["streams"] = f.streams;
+    d["modes_solved"] = f.modes_solved;
+    d["sun_mu"] = f.sun_mu;
+    d["solve_seconds"] = f.solve_seconds;
+    return d;
+}
+
+airlight::SolverOptions solver_options(int streams, int max_fourier_mode, double initial_depth, bool delta_m,
+                                       const std::vector<double>& view_mu, const std::vector<double>& view_phi,
+                                       double azimuth_tolerance) {
+    if (!(azimuth_tolerance >= 0.0 && azimuth_tolerance < 1.0))
+        throw py::value_error("azimuth_tolerance: must be in [0, 1)");
+    if (streams < 2 || streams > 128) throw py::value_error("streams: must be in [2, 128]");
+    if (!(initial_depth > 0.0 && initial_depth <= 16.0)) throw py::value_error("initial_depth: must be in (0, 16]");
+    for (double v : view_mu)
+        if (!(v >= -1.0 && v <= 1.0)) throw py::value_error("view_mu: must be in [-1, 1]");
+    for (double v : view_phi)
+        if (!std::isfinite(v)) throw py::value_error("view_phi: must be finite");
+    airlight::SolverOptions o;
+    o.streams = streams;
+    o.max_fourier_mode = max_fourier_mode;
+    o.initial_depth = initial_depth;
+    o.delta_m = delta_m;
+    o.view_mu = view_mu;
+    o.view_phi = view_phi;
+    o.azimuth_tolerance = azimuth_tolerance;
+    return o;
 }
 
 }  // namespace
@@ -449,6 +514,105 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("rate"), py::arg("wavelength_nm"), py::arg("angles_deg"), py::arg("n_sizes"), py::arg("slope") = 0.0,
         py::arg("d_min") = airlight::RAINDROP_D_MIN_MM, py::arg("d_max") = airlight::RAINDROP_D_MAX_MM);
+    m.def(
+        "solve_plane_parallel",
+        // The slab from the ground up: layer_tops (m), depths [layer][species][channel];
+        // phases per species: "rayleigh", ("hg", g) or ("legendre", [chi_0, chi_1, ...]);
+        // sky(mu, phi) -> (r, g, b) for look directions mu > 0, phi from the sun's azimuth.
+        [](const std::vector<py::object>& phases, const std::vector<double>& layer_tops,
+           const std::vector<std::vector<std::array<double, 3>>>& extinction_depth,
+           const std::vector<std::vector<std::array<double, 3>>>& scattering_depth, double sun_mu,
+           const std::array<double, 3>& sun_irradiance, py::object sky, const std::array<double, 3>& ground_albedo,
+           int streams, int max_fourier_mode, double initial_depth, bool delta_m, const std::vector<double>& view_mu,
+           const std::vector<double>& view_phi, double azimuth_tolerance) {
+            airlight::SlabAtmosphere atm;
+            for (const py::object& p : phases) {
+                if (py::isinstance<py::str>(p) && p.cast<std::string>() == "rayleigh") {
+                    atm.phases.push_back(airlight::PhaseFunction::rayleigh());
+                    continue;
+                }
+                const auto t = p.cast<py::tuple>();
+                const std::string kind = t[0].cast<std::string>();
+                if (kind == "hg") {
+                    const double g = t[1].cast<double>();
+                    if (!(g > -1.0 && g < 1.0)) throw py::value_error("phases: HG g must be in (-1, 1)");
+                    atm.phases.push_back(airlight::PhaseFunction::henyey_greenstein(g));
+                } else if (kind == "legendre") {
+                    atm.phases.push_back(airlight::PhaseFunction::legendre(t[1].cast<std::vector<double>>()));
+                } else {
+                    throw py::value_error("phases: each must be 'rayleigh', ('hg', g) or ('legendre', moments)");
+                }
+            }
+            if (extinction_depth.size() != layer_tops.size() || scattering_depth.size() != layer_tops.size())
+                throw py::value_error("extinction_depth, scattering_depth: one entry per layer");
+            double bottom = 0.0;
+            for (size_t k = 0; k < layer_tops.size(); ++k) {
+                if (!(layer_tops[k] > bottom)) throw py::value_error("layer_tops: must increase from above 0");
+                if (extinction_depth[k].size() != atm.phases.size() || scattering_depth[k].size() != atm.phases.size())
+                    throw py::value_error("extinction_depth, scattering_depth: one entry per species");
+                for (size_t i = 0; i < atm.phases.size(); ++i)
+                    for (int c = 0; c < 3; ++c) {
+                        const double t = extinction_depth[k][i][size_t(c)], sc = scattering_depth[k][i][size_t(c)];
+                        if (!(t >= 0.0 && t < 1e7 && sc >= 0.0 && sc <= t))
+                            throw py::value_error("depths: need 0 <= scattering <= extinction < 1e7");
+                    }
+                airlight::SlabLayer l;
+                l.bottom = bottom;
+                l.top = layer_tops[k];
+                l.extinction_depth = extinction_depth[k];
+                l.scattering_depth = scattering_depth[k];
+                atm.layers.push_back(l);
+                bottom = layer_tops[k];
+            }
+            airlight::SlabIllumination light;
+            if (!(sun_mu >= -1.0 && sun_mu <= 1.0)) throw py::value_error("sun_mu: must be in [-1, 1]");
+            light.sun_mu = sun_mu;
+            light.sun_irradiance = sun_irradiance;
+            light.ground_albedo = ground_albedo;
+            if (!sky.is_none())
+                light.sky_radiance = [sky](double mu, double phi) {
+                    return sky(mu, phi).cast<std::array<double, 3>>();
+                };
+            const airlight::SolverOptions o =
+                solver_options(streams, max_fourier_mode, initial_depth, delta_m, view_mu, view_phi, azimuth_tolerance);
+            return field_to_python(airlight::solve_plane_parallel(atm, light, o));
+        },
+        py::arg("phases"), py::arg("layer_tops"), py::arg("extinction_depth"), py::arg("scattering_depth"),
+        py::arg("sun_mu") = 0.0, py::arg("sun_irradiance") = std::array<double, 3>{0.0, 0.0, 0.0},
+        py::arg("sky") = py::none(), py::arg("ground_albedo") = std::array<double, 3>{0.0, 0.0, 0.0},
+        py::arg("streams") = 16, py::arg("max_fourier_mode") = -1, py::arg("initial_depth") = 1.0 / 16.0,
+        py::arg("delta_m") = true, py::arg("view_mu") = std::vector<double>{},
+        py::arg("view_phi") = std::vector<double>{}, py::arg("azimuth_tolerance") = 1e-4);
+    m.def(
+        "solve_plane_parallel_scene",
+        // A scene's atmosphere, sky and sun (slab_from_species, slab_illumination)
+        // over the levels slab_levels(segments, max_layer_depth).
+        [](py::handle scene_obj, double ground_albedo, int segments, double max_layer_depth, int streams,
+           double initial_depth, double azimuth_tolerance) {
+            const Scene scene = scene_from_python(scene_obj);
+            if (!(ground_albedo >= 0.0 && ground_albedo <= 1.0))
+                throw py::value_error("ground_albedo: must be in [0, 1]");
+            if (segments < 2 || segments > 64) throw py::value_error("segments: must be in [2, 64]");
+            if (!(max_layer_depth > 0.0)) throw py::value_error("max_layer_depth: must be positive");
+            airlight::shader::SpeciesGpu species[airlight::shader::SPECIES_COUNT];
+            airlight::make_species_gpu(scene.atmosphere, species);
+            const std::vector<double> levels = airlight::slab_levels(species, segments, max_layer_depth);
+            const airlight::SlabAtmosphere atm = airlight::slab_from_species(species, levels);
+            const airlight::SlabIllumination light = airlight::slab_illumination(
+                airlight::make_sky_gpu(scene.sky, scene.sun), {ground_albedo, ground_albedo, ground_albedo});
+            const airlight::SolverOptions o =
+                solver_options(streams, -1, initial_depth, true, {}, {}, azimuth_tolerance);
+            airlight::MultipleScatteringField f;
+            {
+                py::gil_scoped_release release;
+                f = airlight::solve_plane_parallel(atm, light, o);
+            }
+            py::dict d = field_to_python(f);
+            d["layers"] = py::ssize_t(atm.layers.size());
+            return d;
+        },
+        py::arg("scene"), py::arg("ground_albedo") = 0.0, py::arg("segments") = 16, py::arg("max_layer_depth") = 2.0,
+        py::arg("streams") = 16, py::arg("initial_depth") = 1.0 / 16.0, py::arg("azimuth_tolerance") = 1e-4);
     m.def("write_pfm",
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));

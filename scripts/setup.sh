@@ -9,7 +9,7 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config python3 python3-dev python3-venv
-          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev nlohmann-json3-dev libglfw3-dev
+          libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev nlohmann-json3-dev libeigen3-dev libglfw3-dev
           clang-format)
 missing=()
 for p in "${packages[@]}"; do

@@ -1,6 +1,6 @@
 """Type stubs of the native module (cpp/python_module.cpp). Use the airlight package."""
 
-from collections.abc import Sequence
+from collections.abc import Callable, Sequence
 from typing import Any
 
 import numpy as np
@@ -48,3 +48,16 @@ def mie_size_average_phase(rate: float, wavelength_nm: float, angles_deg: Sequen
                            d_max: float = ...) -> npt.NDArray[np.float64]: ...
 def glare(radiance: npt.NDArray[np.float32], fov_y: float, pupil_diameter: float,
           eyelashes: bool) -> npt.NDArray[np.float32]: ...
+def solve_plane_parallel(phases: Sequence[str | tuple[str, Any]], layer_tops: Sequence[float],
+                         extinction_depth: Sequence[Sequence[Sequence[float]]],
+                         scattering_depth: Sequence[Sequence[Sequence[float]]], sun_mu: float = ...,
+                         sun_irradiance: Sequence[float] = ...,
+                         sky: Callable[[float, float], Sequence[float]] | None = ...,
+                         ground_albedo: Sequence[float] = ..., streams: int = ...,
+                         max_fourier_mode: int = ..., initial_depth: float = ..., delta_m: bool = ...,
+                         view_mu: Sequence[float] = ..., view_phi: Sequence[float] = ...,
+                         azimuth_tolerance: float = ...) -> dict[str, Any]: ...
+def solve_plane_parallel_scene(scene: Any, ground_albedo: float = ..., segments: int = ...,
+                               max_layer_depth: float = ..., streams: int = ...,
+                               initial_depth: float = ...,
+                               azimuth_tolerance: float = ...) -> dict[str, Any]: ...
