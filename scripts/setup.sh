@@ -28,7 +28,8 @@ if [ ! -x .venv/bin/python ]; then
 fi
 .venv/bin/python -m pip install -q --upgrade pip
 .venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib colour-science \
-    "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy
+    "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy \
+    PythonicDISORT  # an independent DISORT, the multiple-scattering solver's reference in tests
 # --no-build-isolation: build with the tools just installed in .venv
 # (incremental: the build directory build/python is kept between runs).
 .venv/bin/python -m pip install -q --no-build-isolation .
