@@ -33,6 +33,9 @@ from hypothesis import strategies as st
 from image_checks import finite_non_negative as _finite_non_negative
 
 BACKENDS = ("cpu", "gl")
+# The smallest radius of a 1e30 W/sr lamp: its core radiance I / (pi r^2) stays within the
+# scene format's radiance bound 1e30 (r >= 0.564 m).
+BRIGHTEST_LAMP_RADIUS = 0.6
 FLOAT32_FLOOR = 1e-37  # relative to a light's own radiance scale: below it float32 may give 0
 
 
@@ -224,7 +227,7 @@ def test_optical_thickness_beyond_table_range(optical, backend):
     sigma_t = 2.0
     far = optical / sigma_t
     scene = make_scene((0, 0, 0), (0, 0, -1),
-                       [light((0.3, 0.2, -0.5), 10.0), light((0.5, 0.0, far - 1.0), 1e30)],
+                       [light((0.3, 0.2, -0.5), 10.0), light((0.5, 0.0, far - 1.0), 1e30, BRIGHTEST_LAMP_RADIUS)],
                        [plane((0, 0, -1.0), (0, 0, 1), 0.5)], sigma_t=sigma_t, albedo=0.8, fov_y=20.0,
                        width=12, height=8)
     image = np.asarray(get_renderer(backend).render(scene), dtype=np.float64)
@@ -342,7 +345,7 @@ def test_continuity_of_glow_across_table_end(backend):
     ts = np.concatenate([np.arange(60.0, 90.0, 0.5), np.arange(90.0, 220.01, 2.0)])
     th = math.radians(60.0)
     scenes = [make_scene((0, 0.05, 0), (0, 0, 0),
-                         [light((t * math.sin(th), t * math.cos(th), 0.0), intensity)],
+                         [light((t * math.sin(th), t * math.cos(th), 0.0), intensity, BRIGHTEST_LAMP_RADIUS)],
                          [plane((0, 0, 0), (0, 1, 0), albedo)], sigma_t=sigma_t, albedo=1.0, fov_y=1.0,
                          width=1, height=1, up=(0, 0, -1)) for t in ts]
     got, ref = _sweep(backend, scenes)
