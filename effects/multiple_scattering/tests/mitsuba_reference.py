@@ -29,7 +29,8 @@ ground plane y = 0, lit by the sky dome (radiance entering the top) and the sun.
   the Mie rainbow phase is not modelled here.
 * **Lights.** The sky dome as an ``envmap``: a lat-long bitmap of Lz shape(w) (0 below the
   horizon) in Mitsuba's mapping u = atan2(x, -z) / (2 pi), v = acos(y) / pi, which is exactly
-  airlight's azimuth convention (az 0 along -z, 90 along +x). The sun as a ``directional``
+  airlight's azimuth convention (az 0 along -z, 90 along +x); its rows are nodes in theta,
+  its columns texel centres in azimuth (``sky_bitmap``). The sun as a ``directional``
   emitter of irradiance E_sun. Light enters only through the top (and through the far sides for
   rays within about 1 degree of the horizon).
 * **Ground.** A ``rectangle`` at y = 0 with a ``diffuse`` BSDF (albedo 0: a black ground that
@@ -66,7 +67,7 @@ HALF_WIDTH = 5.0e6  # m, half the slab's width
 TEXEL_SCALE_FRACTION = 0.01  # texel height / the local scale height of the extinction
 MAX_TEXELS = 4096
 THIN_LAYER_DEPTH = 0.2  # a layer may span several e-folds while its majorant depth is below this
-ENVMAP_HEIGHT = 1024  # rows of the sky bitmap over 180 degrees (0.18 degree per row)
+ENVMAP_HEIGHT = 1025  # rows (nodes) of the sky bitmap over 180 degrees: 0.176 degree apart
 BATCH = 1 << 18  # samples per volpath.sample call
 
 
@@ -238,14 +239,18 @@ def _phase_dict(layer: Layer, g_aerosol: float, g_rain: float, half_width: float
 
 
 def sky_bitmap(sky: ref.Sky, channel: int, height: int = ENVMAP_HEIGHT) -> np.ndarray:
-    """(height, 2 height, 3) float32 grey lat-long radiance of the dome in Mitsuba's envmap mapping,
-    texel centres (row i at theta = (i + 0.5) pi / height from +y; column j at azimuth
-    (j + 0.5) 2 pi / width, direction (sin az sin theta, cos theta, -cos az sin theta))."""
-    width = 2 * height
-    theta = (np.arange(height) + 0.5) * math.pi / height
+    """(height, width, 3) float32 grey lat-long radiance of the dome in Mitsuba's envmap lookup
+    (src/emitters/envmap.cpp, eval_spectrum): row i is the node theta_i = i pi / (height - 1)
+    from +y (rows are nodes, the first the zenith and the last the nadir; an odd height puts a
+    row on the horizon), column j the texel centre at azimuth (j + 0.5) 2 pi / width, width =
+    2 (height - 1), direction (sin az sin theta, cos theta, -cos az sin theta); bilinear in
+    between. Radiance Lz shape(w), 0 below the horizon."""
+    width = 2 * (height - 1)
+    theta = np.arange(height) * math.pi / (height - 1)
     az = (np.arange(width) + 0.5) * 2.0 * math.pi / width
     st, ct = np.sin(theta)[:, None], np.cos(theta)[:, None]
     dirs = np.stack(np.broadcast_arrays(np.sin(az)[None, :] * st, ct, -np.cos(az)[None, :] * st), axis=-1)
+    dirs[np.abs(dirs[..., 1]) < 1e-12, 1] = 0.0  # the horizon row exactly on the horizon
     val = sky.shape(dirs) * float(sky.lz[channel])
     return np.repeat(val.astype(np.float32)[..., None], 3, axis=-1)
 
@@ -358,42 +363,94 @@ class Estimate:
     settings: dict = field(default_factory=dict)
 
 
+class Accumulator:
+    """Running sums of volpath samples along fixed directions from one origin: add batches of
+    samples until a noise target or a time limit is met."""
+
+    def __init__(self, scene: Any, medium: Any, origin: Sequence[float], directions: np.ndarray,
+                 max_depth: int = -1, seed: int = 0, rr_depth: int = 5) -> None:
+        mi = _m()
+        self.scene, self.medium = scene, medium
+        self.origin = np.asarray(origin, dtype=np.float32)
+        self.dirs = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
+        self.integrator = mi.load_dict({"type": "volpath", "max_depth": int(max_depth),
+                                        "rr_depth": int(rr_depth)})
+        self.sampler = mi.load_dict({"type": "independent"})
+        self.seed, self.max_depth, self.rr_depth = seed, max_depth, rr_depth
+        n = self.dirs.shape[0]
+        self.s1 = np.zeros(n)
+        self.s2 = np.zeros(n)
+        self.spp = 0
+        self.batch = 0
+        self.seconds = 0.0
+
+    def add(self, spp: int) -> None:
+        """``spp`` more samples per direction (in batches of at most BATCH lanes, batch b seeded
+        with (seed * 1000003 + b) mod 2^32)."""
+        mi = _m()
+        n_dir = self.dirs.shape[0]
+        per_batch = max(1, BATCH // n_dir)
+        done = 0
+        t0 = time.perf_counter()
+        while done < spp:
+            k = min(per_batch, spp - done)
+            lanes = n_dir * k
+            d = np.repeat(self.dirs, k, axis=0).astype(np.float32)
+            o = np.broadcast_to(self.origin, d.shape)
+            ray = mi.Ray3f(mi.Point3f(o[:, 0], o[:, 1], o[:, 2]), mi.Vector3f(d[:, 0], d[:, 1], d[:, 2]))
+            self.sampler.seed((self.seed * 1000003 + self.batch) % (1 << 32), lanes)
+            result = self.integrator.sample(self.scene, self.sampler, ray, self.medium)
+            # grey problem in an RGB variant: the three components are equal; take the first
+            val = np.asarray(result[0], dtype=np.float64).reshape(lanes, -1)[:, 0].reshape(n_dir, k)
+            val = np.where(np.isfinite(val), val, 0.0)
+            self.s1 += val.sum(axis=1)
+            self.s2 += np.square(val).sum(axis=1)
+            done += k
+            self.batch += 1
+        self.spp += spp
+        self.seconds += time.perf_counter() - t0
+
+    @property
+    def mean(self) -> np.ndarray:
+        return self.s1 / max(self.spp, 1)
+
+    @property
+    def stderr(self) -> np.ndarray:
+        n = max(self.spp, 1)
+        m = self.s1 / n
+        var = np.maximum(self.s2 / n - m * m, 0.0) * n / max(n - 1, 1)
+        return np.sqrt(var / n)
+
+    def result(self) -> Estimate:
+        return Estimate(self.mean, self.stderr, self.spp, self.seconds,
+                        {"max_depth": self.max_depth, "rr_depth": self.rr_depth, "seed": self.seed,
+                         "variant": _m().variant()})
+
+    def run(self, target_rel: float, max_seconds: float, min_spp: int = 1024, max_spp: int = 1 << 26,
+            chunk: int = 4096, floor_fraction: float = 0.0, progress=None) -> Estimate:
+        """Adds ``chunk`` samples per direction until every direction's standard error is below
+        ``target_rel`` of max(its mean, floor_fraction x the largest mean), or ``max_seconds``
+        or ``max_spp`` is reached (at least ``min_spp``). Stopping on the estimated error biases
+        the mean by far less than its standard error for the thousands of samples used."""
+        while True:
+            self.add(chunk if self.spp >= min_spp else min_spp)
+            m, e = self.mean, self.stderr
+            scale = np.maximum(m, floor_fraction * float(m.max()))
+            worst = float(np.max(np.where(scale > 0.0, e / np.where(scale > 0.0, scale, 1.0), np.inf)))
+            if progress is not None:
+                progress(self.spp, worst, self.seconds)
+            if worst <= target_rel or self.seconds >= max_seconds or self.spp >= max_spp:
+                return self.result()
+
+
 def estimate(scene: Any, medium: Any, origin: Sequence[float], directions: np.ndarray, spp: int,
              max_depth: int = -1, seed: int = 0, rr_depth: int = 5) -> Estimate:
     """Mean radiance along each of ``directions`` (N, 3) from ``origin`` with ``spp`` samples
     each, by volpath with ``max_depth`` (-1 unlimited); the standard error is the samples'
-    standard deviation over sqrt(spp). Batches of at most BATCH samples, each seeded with
-    (seed * 1000003 + batch index) mod 2^32."""
-    mi = _m()
-    integrator = mi.load_dict({"type": "volpath", "max_depth": int(max_depth), "rr_depth": int(rr_depth)})
-    dirs = np.asarray(directions, dtype=np.float64).reshape(-1, 3)
-    n_dir = dirs.shape[0]
-    per_batch = max(1, BATCH // n_dir)
-    s1 = np.zeros(n_dir)
-    s2 = np.zeros(n_dir)
-    done = 0
-    batch = 0
-    sampler = mi.load_dict({"type": "independent"})
-    t0 = time.perf_counter()
-    while done < spp:
-        k = min(per_batch, spp - done)
-        lanes = n_dir * k
-        d = np.repeat(dirs, k, axis=0).astype(np.float32)
-        o = np.broadcast_to(np.asarray(origin, dtype=np.float32), d.shape)
-        ray = mi.Ray3f(mi.Point3f(o[:, 0], o[:, 1], o[:, 2]), mi.Vector3f(d[:, 0], d[:, 1], d[:, 2]))
-        sampler.seed((seed * 1000003 + batch) % (1 << 32), lanes)
-        result = integrator.sample(scene, sampler, ray, medium)
-        # grey problem in an RGB variant: the three components are equal; take the first
-        val = np.asarray(result[0], dtype=np.float64).reshape(lanes, -1)[:, 0].reshape(n_dir, k)
-        val = np.where(np.isfinite(val), val, 0.0)
-        s1 += val.sum(axis=1)
-        s2 += np.square(val).sum(axis=1)
-        done += k
-        batch += 1
-    mean = s1 / spp
-    var = np.maximum(s2 / spp - mean * mean, 0.0) * spp / max(spp - 1, 1)
-    return Estimate(mean, np.sqrt(var / spp), spp, time.perf_counter() - t0,
-                    {"max_depth": max_depth, "rr_depth": rr_depth, "seed": seed, "variant": mi.variant()})
+    standard deviation over sqrt(spp)."""
+    acc = Accumulator(scene, medium, origin, directions, max_depth, seed, rr_depth)
+    acc.add(spp)
+    return acc.result()
 
 
 def estimate_day(scene: dict, directions: np.ndarray, spp: int, max_depth: int = -1, seed: int = 0,
