@@ -23,6 +23,7 @@ import datetime
 import fnmatch
 import json
 import math
+import re
 import sys
 import zlib
 from pathlib import Path
@@ -113,7 +114,7 @@ def day_case(weather: str, sun: str, args: argparse.Namespace, progress: Progres
                 disc["texels"].append(int(sum(la.sigma_t.size for la in built.layers)))
                 disc["column_error"].append(mr.discretisation_column_error(atm, built.layers, c))
             seed = _seed(args.seed, name, comp, c)
-            acc = mr.Accumulator(built.scene, built.camera_medium, origin, dirs, -1, seed)
+            acc = mr.Accumulator(built.scene, built.camera_medium, origin, dirs, -1, seed, args.rr_depth)
             est = acc.run(args.target, args.max_seconds, args.min_spp, args.max_spp, args.chunk)
             m[:, c], e[:, c] = est.mean, est.stderr
             info["spp"].append(est.spp)
@@ -152,7 +153,7 @@ def night_case(tau: float, g: float, args: argparse.Namespace, progress: Progres
                                          [0.0, 0.0, 0.0], radius)
     origin, dirs = mr.lamp_directions(ms_cases.LAMP_DISTANCE, ms_cases.GLOW_ANGLES)
     seed = _seed(args.seed, name)
-    acc = mr.Accumulator(mscene, medium, origin, dirs, -1, seed)
+    acc = mr.Accumulator(mscene, medium, origin, dirs, -1, seed, args.rr_depth)
     est = acc.run(args.target, args.max_seconds_night, args.min_spp, args.max_spp, args.chunk,
                   floor_fraction=1e-3)
     progress.step(name, est, _worst(est, 1e-3))
@@ -182,13 +183,21 @@ def _header(args: argparse.Namespace, kind: str) -> dict[str, Any]:
                        "(W/(m^2 sr) per channel); stderr: one standard error of the mean.",
         "generator": "effects/multiple_scattering/bench/make_reference.py",
         "mitsuba": mitsuba.__version__, "variant": mr.MITSUBA_VARIANT,
-        "settings": {"max_depth": -1, "rr_depth": 5, "target_rel": args.target, "chunk_spp": args.chunk,
+        "settings": {"max_depth": -1, "rr_depth": args.rr_depth, "target_rel": args.target,
+                     "chunk_spp": args.chunk,
                      "min_spp": args.min_spp, "max_seconds_per_render": args.max_seconds if kind == "day"
                      else args.max_seconds_night, "base_seed": args.seed, "threads": args.threads,
                      "half_width_m": mr.HALF_WIDTH, "envmap_height": mr.ENVMAP_HEIGHT,
                      "texel_scale_fraction": mr.TEXEL_SCALE_FRACTION, "thin_layer_depth": mr.THIN_LAYER_DEPTH,
                      "density_floor": mr.DENSITY_FLOOR},
     }
+
+
+def dump(data: dict[str, Any]) -> str:
+    """JSON with one key per line and every list of numbers on one line (small, diff-friendly)."""
+    text = json.dumps(data, indent=1)
+    return re.sub(r"\[\s*([-+0-9.eE]+(?:,\s*[-+0-9.eE]+)*)\s*\]",
+                  lambda m: "[" + ", ".join(x.strip() for x in m.group(1).split(",")) + "]", text) + "\n"
 
 
 def _merge(path: Path, header: dict[str, Any], cases: dict[str, Any]) -> dict[str, Any]:
@@ -204,8 +213,7 @@ def _merge(path: Path, header: dict[str, Any], cases: dict[str, Any]) -> dict[st
     data["cases"] = dict(sorted(data["cases"].items()))
     path.parent.mkdir(parents=True, exist_ok=True)
     with open(path, "w") as f:
-        json.dump(data, f, indent=1)
-        f.write("\n")
+        f.write(dump(data))
     return data
 
 
@@ -281,6 +289,24 @@ def validate(args: argparse.Namespace) -> str:
     return "\n".join(lines)
 
 
+def refresh_airlight(path: Path) -> None:
+    """Rebuilds every stored view's camera from its direction and re-renders airlight's value
+    (``airlight_single``) without touching the Mitsuba values."""
+    if not path.exists():
+        return
+    with open(path) as f:
+        data = json.load(f)
+    for case in data["cases"].values():
+        origin = case["scene"]["camera"]["position"]
+        case["scene"]["camera"] = ms_cases.camera(origin, np.array(case["views"][0]["direction"]))
+        for view in case["views"]:
+            view["camera"] = ms_cases.camera(origin, np.array(view["direction"]))
+            pixel = _airlight_pixel(dict(case["scene"], camera=view["camera"]))
+            view["airlight_single"] = pixel if isinstance(view["radiance"], list) else pixel[1]
+    with open(path, "w") as f:
+        f.write(dump(data))
+
+
 def main(argv: list[str] | None = None) -> int:
     p = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     p.add_argument("--kind", choices=("day", "night", "all"), default="all")
@@ -292,9 +318,15 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--max-spp", type=int, default=1 << 26)
     p.add_argument("--chunk", type=int, default=8192, help="samples per view between checks")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--rr-depth", type=int, default=5,
+                   help="volpath's Russian roulette depth (5: Mitsuba's default; 1000 for fog: RR from "
+                        "depth 5 kills the long paths of thick, nearly conservative media, 15 times less "
+                        "efficient for fog50)")
     p.add_argument("--threads", type=int, default=1)
     p.add_argument("--out", type=Path, default=ms_cases.DATA_DIR)
     p.add_argument("--table", action="store_true", help="only print the tables of the stored data")
+    p.add_argument("--refresh-airlight", action="store_true",
+                   help="only re-render the stored airlight values (and view cameras), no Mitsuba")
     p.add_argument("--validate", action="store_true",
                    help="only the single-scattering check against airlight (a table), nothing stored")
     args = p.parse_args(argv)
@@ -307,6 +339,11 @@ def main(argv: list[str] | None = None) -> int:
                  if wanted(ms_cases.day_case_name(w, s))] if args.kind in ("day", "all") else []
     night_names = [(t, g) for t in ms_cases.NIGHT_TAUS for g in ms_cases.NIGHT_GS
                    if wanted(ms_cases.night_case_name(t, g))] if args.kind in ("night", "all") else []
+    if args.refresh_airlight:
+        for kind in ("day", "night"):
+            if args.kind in (kind, "all"):
+                refresh_airlight(args.out / f"{kind}_reference.json")
+        return 0
     if args.validate:
         mr.load_mitsuba(args.threads)
         print(validate(args))
