@@ -87,6 +87,14 @@ def _airlight_pixel(scene: dict) -> list[float]:
 # Daytime
 
 
+def _stored_case(args: argparse.Namespace, name: str) -> dict[str, Any] | None:
+    path = args.out / "day_reference.json"
+    if not path.exists():
+        return None
+    with open(path) as f:
+        return json.load(f)["cases"].get(name)
+
+
 def day_case(weather: str, sun: str, args: argparse.Namespace, progress: Progress) -> dict[str, Any]:
     name = ms_cases.day_case_name(weather, sun)
     scene = ms_cases.day_scene(weather, sun)
@@ -98,10 +106,21 @@ def day_case(weather: str, sun: str, args: argparse.Namespace, progress: Progres
     errs: dict[str, np.ndarray] = {}
     disc: dict[str, Any] = {"layers": [], "texels": [], "column_error": []}
     atm = ds.reference_atmosphere(scene)
+    previous = _stored_case(args, name) if args.parts != "all" else None
     for comp in components:
+        if previous is not None and comp not in args.parts.split(","):
+            # keep the stored part
+            means[comp] = np.array([v[f"radiance_{comp}"] for v in previous["views"]])
+            errs[comp] = np.array([v[f"stderr_{comp}"] for v in previous["views"]])
+            out_comp[comp] = previous["components"][comp]
+            if comp == "sky":
+                disc = previous["discretisation"]
+            continue
         part = json.loads(json.dumps(scene))
         if comp == "sky":
-            part.pop("sun", None)
+            # the sun stays where it is (it places the CIE sky's indicatrix) but gives no light
+            if "sun" in part:
+                part["sun"]["irradiance"] = [0.0, 0.0, 0.0]
         else:
             part["sky"]["zenith_radiance"] = [0.0, 0.0, 0.0]
         m = np.zeros((len(dirs), 3))
@@ -236,6 +255,19 @@ def day_table(data: dict[str, Any]) -> str:
     return "\n".join(lines)
 
 
+def noise_table(data: dict[str, Any]) -> str:
+    """Per daytime case: the relative standard error over its views and channels."""
+    lines = ["| case | median rel. stderr | 90 % | max | column error (max) | layers | rr_depth |",
+             "|---|---|---|---|---|---|---|"]
+    for name, case in data["cases"].items():
+        rel = np.array([[e / m for e, m in zip(v["stderr"], v["radiance"])] for v in case["views"]])
+        disc = case["discretisation"]
+        lines.append(f"| {name} | {np.median(rel):.4f} | {np.quantile(rel, 0.9):.4f} | {rel.max():.4f} | "
+                     f"{max(disc['column_error']):.1e} | {max(disc['layers'])} | "
+                     f"{case['settings']['rr_depth']} |")
+    return "\n".join(lines)
+
+
 def night_table(data: dict[str, Any]) -> str:
     lines = ["| case | spp | worst rel. stderr (above 1e-3 of peak) | glow >= 1e-3 peak to (deg) "
              "| MS/SS at 1 deg | 10 deg | 45 deg | 90 deg |", "|---|---|---|---|---|---|---|---|"]
@@ -318,6 +350,8 @@ def main(argv: list[str] | None = None) -> int:
     p.add_argument("--max-spp", type=int, default=1 << 26)
     p.add_argument("--chunk", type=int, default=8192, help="samples per view between checks")
     p.add_argument("--seed", type=int, default=0)
+    p.add_argument("--parts", default="all",
+                   help="daytime parts to render, 'sky', 'sun' or 'all'; the others are kept from the file")
     p.add_argument("--rr-depth", type=int, default=5,
                    help="volpath's Russian roulette depth (5: Mitsuba's default; 1000 for fog: RR from "
                         "depth 5 kills the long paths of thick, nearly conservative media, 15 times less "
@@ -350,7 +384,8 @@ def main(argv: list[str] | None = None) -> int:
         return 0
     if not args.table:
         mr.load_mitsuba(args.threads)
-        renders = sum(3 * (2 if s != "overcast" else 1) for _w, s in day_names) + len(night_names)
+        parts = 2 if args.parts == "all" else len(args.parts.split(","))
+        renders = sum(3 * (parts if s != "overcast" else 1) for _w, s in day_names) + len(night_names)
         progress = Progress(renders)
         # one case at a time, so that an interrupted run keeps what it finished
         for t, g in night_names:
@@ -360,12 +395,14 @@ def main(argv: list[str] | None = None) -> int:
             _merge(args.out / "day_reference.json", _header(args, "day"),
                    {ms_cases.day_case_name(w, s): day_case(w, s, args, progress)})
         progress.close()
-    for kind, table in (("day", day_table), ("night", night_table)):
+    for kind, table in (("day", day_table), ("night", night_table), ("day", noise_table)):
         path = args.out / f"{kind}_reference.json"
         if path.exists() and args.kind in (kind, "all"):
             with open(path) as f:
-                print(f"\n{kind}: Mitsuba multiple scattering (MS) vs airlight single scattering (SS), "
-                      "green\n")
+                title = ("noise of the daytime cases" if table is noise_table else
+                         f"{kind}: Mitsuba multiple scattering (MS) vs airlight single scattering (SS), "
+                         "green")
+                print(f"\n{title}\n")
                 print(table(json.load(f)))
     return 0
 
