@@ -3,7 +3,7 @@ scattering (volpath max_depth = 2), it agrees with airlight's current renders, w
 scattering, on sky and ground pixels of several daytime presets and on the glow of a lamp in fog.
 A second check shows the comparison has the power to see one more scattering order.
 
-Skipped without Mitsuba (pip install ".[reference]"); slow (about a minute and a half on one
+Skipped without Mitsuba (pip install ".[reference]"); slow (about 25 s on one
 thread). Tolerance per pixel and channel: 4.5 standard errors of the path tracer plus 1 % for
 airlight's own discretisation (effects/daytime/physics.md section 7 measures up to 0.6 %)."""
 
