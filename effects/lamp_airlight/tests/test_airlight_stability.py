@@ -227,7 +227,8 @@ def test_optical_thickness_beyond_table_range(optical, backend):
     sigma_t = 2.0
     far = optical / sigma_t
     scene = make_scene((0, 0, 0), (0, 0, -1),
-                       [light((0.3, 0.2, -0.5), 10.0), light((0.5, 0.0, far - 1.0), 1e30, BRIGHTEST_LAMP_RADIUS)],
+                       [light((0.3, 0.2, -0.5), 10.0),
+                        light((0.5, 0.0, far - 1.0), 1e30, BRIGHTEST_LAMP_RADIUS)],
                        [plane((0, 0, -1.0), (0, 0, 1), 0.5)], sigma_t=sigma_t, albedo=0.8, fov_y=20.0,
                        width=12, height=8)
     image = np.asarray(get_renderer(backend).render(scene), dtype=np.float64)
