@@ -10,8 +10,8 @@
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
-#include <thread>
 
+#include "numerics.hpp"
 #include "sky.hpp"
 
 namespace airlight {
@@ -651,9 +651,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
         };
         if (opt.threads > 1) {
             Cache caches[3];
-            std::vector<std::thread> pool;
-            for (int c = 0; c < 3; ++c) pool.emplace_back(solve_channel, c, std::ref(caches[c]));
-            for (std::thread& t : pool) t.join();
+            numerics::parallel_for(
+                3, [&](int c) { solve_channel(c, caches[c]); }, opt.threads);
         } else {
             Cache cache;  // shared: grey channels reuse each other's layers
             for (int c = 0; c < 3; ++c) solve_channel(c, cache);
