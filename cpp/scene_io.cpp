@@ -20,6 +20,7 @@
 #include <vector>
 
 #include "airlight_registry.hpp"
+#include "numerics.hpp"
 #include "scene_json.hpp"
 #include "scene_keys.hpp"
 
@@ -160,7 +161,7 @@ float read_light_radius(const SceneObject& o, const Rgb& intensity) {
     const float r =
         given ? read_in_range(*given, min_light_radius, max_light_radius, " m") : float(default_light_radius);
     const double peak = std::max({double(intensity.x), double(intensity.y), double(intensity.z)});
-    const double radiance = peak / (3.14159265358979 * double(r) * double(r));
+    const double radiance = peak / (numerics::kPi * double(r) * double(r));
     if (radiance > max_radiometric) {
         const std::string field = given ? given->field : o.req("intensity").field;
         fail(Kind::value, field,
