@@ -1,0 +1,20 @@
+// The lamps' multiple-scattering table's coordinates (EFFECT_GLSL_MATH: the
+// shading pass and effects/multiple_scattering/point_source.cpp, which builds
+// the table, share them). Texel (ix, iy) holds log L(tau, gamma) per albedo
+// channel (RGB), L the radiance of the light scattered at least twice seen from
+// optical distance tau from a lamp of unit intensity in a medium of unit
+// extinction, at angle gamma from the lamp's direction
+// (effects/multiple_scattering/physics.md section 11).
+CONST int LAMP_MS_NX = 128;  // optical distance: X = log(tau / TAU_MIN) / log(TAU_MAX / TAU_MIN)
+CONST int LAMP_MS_NY = 96;   // angle: Y = log(1 + gamma / GAMMA0) / log(1 + pi / GAMMA0)
+CONST float LAMP_MS_TAU_MIN = 1.0e-3f;  // below: L held (it grows only as log(1 / tau))
+CONST float LAMP_MS_TAU_MAX = 64.0f;    // beyond: no multiple scattering (section 12)
+CONST float LAMP_MS_GAMMA0 = 0.02f;     // radians: rows fine near the lamp's direction
+CONST float LAMP_MS_GAMMA_MIN = 1.0e-4f;  // the first row is built at this angle (L diverges as log 1 / gamma)
+CONST float LAMP_MS_LOG_FLOOR = -700.0f;  // log of an empty texel
+
+INLINE float lamp_ms_x(float tau) {
+    return log(max(tau, LAMP_MS_TAU_MIN) / LAMP_MS_TAU_MIN) / log(LAMP_MS_TAU_MAX / LAMP_MS_TAU_MIN);
+}
+
+INLINE float lamp_ms_y(float gamma) { return log(1.0f + gamma / LAMP_MS_GAMMA0) / log(1.0f + PI / LAMP_MS_GAMMA0); }

@@ -1,0 +1,17 @@
+// PLACEHOLDER (branch ms-night; ms_quality_placeholder.hpp): the quality key
+// "multiple_scattering", a bool, default true.
+#include "scene_keys.hpp"
+
+namespace airlight {
+
+using namespace scene_keys;
+
+void parse_multiple_scattering_quality(const SceneObject& quality, Scene& s) {
+    if (auto v = quality.opt("multiple_scattering")) s.quality.multiple_scattering = read_bool(*v);
+}
+
+void write_multiple_scattering_quality(const Scene& s, json& quality) {
+    quality["multiple_scattering"] = s.quality.multiple_scattering;
+}
+
+}  // namespace airlight
