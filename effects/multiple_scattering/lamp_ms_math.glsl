@@ -5,8 +5,8 @@
 // optical distance tau from a lamp of unit intensity in a medium of unit
 // extinction, at angle gamma from the lamp's direction
 // (effects/multiple_scattering/physics.md section 11).
-CONST int LAMP_MS_NX = 128;  // optical distance: X = log(tau / TAU_MIN) / log(TAU_MAX / TAU_MIN)
-CONST int LAMP_MS_NY = 96;   // angle: Y = log(1 + gamma / GAMMA0) / log(1 + pi / GAMMA0)
+CONST int LAMP_MS_NX = 96;   // optical distance: X = log(tau / TAU_MIN) / log(TAU_MAX / TAU_MIN)
+CONST int LAMP_MS_NY = 80;   // angle: Y = log(1 + gamma / GAMMA0) / log(1 + pi / GAMMA0)
 CONST float LAMP_MS_TAU_MIN = 1.0e-3f;  // below: L held (it grows only as log(1 / tau))
 CONST float LAMP_MS_TAU_MAX = 64.0f;    // beyond: no multiple scattering (section 12)
 CONST float LAMP_MS_GAMMA0 = 0.02f;     // radians: rows fine near the lamp's direction

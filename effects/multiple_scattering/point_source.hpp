@@ -32,7 +32,7 @@ PointSourcePhase point_source_phase(const Phase& phase);
 // counted `collision_budget` collisions (or `max_photons` photons); the result
 // depends on seed and budget only, not on the number of threads.
 struct PointSourceSettings {
-    double collision_budget = 4.0e7;
+    double collision_budget = 2.0e7;
     long max_photons = 4000000;
     uint64_t seed = 18;
     int threads = 0;

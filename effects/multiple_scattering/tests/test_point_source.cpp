@@ -112,6 +112,7 @@ void check_seed_noise() {
                 const double a = point_source_radiance(f1, tau, deg * kPi / 180.0)[0];
                 const double b = point_source_radiance(f2, tau, deg * kPi / 180.0)[0];
                 worst = std::max(worst, std::abs(a - b) / (0.5 * (a + b)));
+                if (g_print) std::printf("  tau %5.1f gamma %5.1f: %.5g %.5g (%+.4f)\n", tau, deg, a, b, (a - b) / (0.5 * (a + b)));
             }
         if (g_print)
             std::printf("g %.2f: %ld photons, %.3g collisions, MC %.2f s, worst seed difference %.4f\n", g,
