@@ -22,6 +22,29 @@ for _dir in TEST_DIRS:
 
 BACKENDS = ("cpu", "gl")
 
+# Issue 18 turned multiple scattering on by default (quality.multiple_scattering). The tests written
+# before it check the single-scattering renderer against single-scattering references, so a scene dict
+# rendered outside effects/multiple_scattering/ renders with it off unless the scene sets it.
+MULTIPLE_SCATTERING_TESTS = ROOT / "effects" / "multiple_scattering"
+
+
+@pytest.fixture(autouse=True)
+def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    if Path(str(request.fspath)).resolve().is_relative_to(MULTIPLE_SCATTERING_TESTS):
+        return
+    from airlight import _rendering
+
+    original = _rendering._with_film_size
+
+    def single_scattering(scene: Any, width: Any, height: Any) -> Any:
+        if isinstance(scene, dict):
+            quality = scene.get("quality")
+            if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
+                scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
+        return original(scene, width, height)
+
+    monkeypatch.setattr(_rendering, "_with_film_size", single_scattering)
+
 
 def skip_unless_backend_available(backend: str) -> None:
     """Skips the calling test when ``backend`` cannot run on this machine."""

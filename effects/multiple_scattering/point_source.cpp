@@ -381,14 +381,22 @@ Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<doub
     t.height = LAMP_MS_NY;
     t.channels = 4;
     t.texels.assign(size_t(t.width) * size_t(t.height) * 4, 0.0f);
-    const double log_tau = std::log(double(LAMP_MS_TAU_MAX) / double(LAMP_MS_TAU_MIN));
+    const double tau_min = double(LAMP_MS_TAU_MIN), tau_lin = double(LAMP_MS_TAU_LIN);
+    const double w_max = std::log(double(LAMP_MS_TAU_MAX) / tau_min) + double(LAMP_MS_TAU_MAX) / tau_lin;
+    // The inverse of lamp_ms_x: w(tau) = log(tau / tau_min) + tau / tau_lin by Newton's method.
+    auto tau_at = [&](double X) {
+        const double w = X * w_max;
+        double tau = std::min(tau_min * std::exp(w), tau_lin * w);
+        for (int k = 0; k < 60; ++k) tau = std::max(tau - (std::log(tau / tau_min) + tau / tau_lin - w) / (1.0 / tau + 1.0 / tau_lin), 0.5 * tau);
+        return tau;
+    };
     const double log_gamma = std::log(1.0 + kPi / double(LAMP_MS_GAMMA0));
     numerics::parallel_for(
         t.width * t.height,
         [&](int i) {
             const int ix = i % t.width, iy = i / t.width;
             // The inverses of lamp_ms_x and lamp_ms_y (lamp_ms_math.glsl).
-            const double tau = double(LAMP_MS_TAU_MIN) * std::exp(log_tau * ix / (t.width - 1));
+            const double tau = ix == 0 ? tau_min : tau_at(double(ix) / (t.width - 1));
             const double gamma = std::clamp(double(LAMP_MS_GAMMA0) * std::expm1(log_gamma * iy / (t.height - 1)),
                                             double(LAMP_MS_GAMMA_MIN), kPi);
             const std::array<double, 3> l = point_source_radiance(field, tau, gamma);
