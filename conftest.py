@@ -6,6 +6,7 @@ reference implementations beside it (and the core's helpers) by name."""
 from __future__ import annotations
 
 import copy
+import json
 import sys
 from pathlib import Path
 from typing import Any, Callable
@@ -36,12 +37,22 @@ def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: 
 
     original = _rendering._with_film_size
 
+    def off(scene: Any) -> Any:
+        quality = scene.get("quality")
+        if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
+            scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
+        return scene
+
     def single_scattering(scene: Any, width: Any, height: Any) -> Any:
-        if isinstance(scene, dict):
-            quality = scene.get("quality")
-            if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
-                scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
-        return original(scene, width, height)
+        source = original(off(scene) if isinstance(scene, dict) else scene, width, height)
+        if isinstance(source, str):  # JSON text or a file's text
+            try:
+                data = json.loads(source)
+            except (ValueError, RecursionError):
+                return source  # the validator names the error
+            if isinstance(data, dict):
+                return json.dumps(off(data))
+        return source
 
     monkeypatch.setattr(_rendering, "_with_film_size", single_scattering)
 

@@ -4,7 +4,7 @@
 set(EFFECT_SOURCES plane_parallel.cpp)
 
 # ---- Night (issue 18, branch ms-night): point lamps' multiple scattering in
-# the homogeneous medium (physics.md sections 10 to 12; docs/lamps.md).
+# the homogeneous medium (physics.md sections 10 to 12; effects/multiple_scattering/docs/lamps.md).
 list(APPEND EFFECT_SOURCES point_source.cpp lamp_ms_frame.cpp ms_frame.cpp)
 list(APPEND EFFECT_GLSL_MATH lamp_ms_math.glsl)
 list(APPEND EFFECT_GLSL_TERMS lamp_ms_terms.glsl)

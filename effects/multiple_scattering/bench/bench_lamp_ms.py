@@ -1,7 +1,8 @@
 """Benchmark of the lamps' multiple scattering (issue 18, night; effects/multiple_scattering/docs/lamps.md):
 
-1. error against the stored Mitsuba 3 path-traced glows (tests/data/night_reference.json) per case, the
-   table method (airlight) against the brute force (the path tracer's own time per case);
+1. error against the stored Mitsuba 3 path-traced glows
+   (effects/multiple_scattering/tests/data/night_reference.json) per case:
+   the table method (airlight) against the brute force (the path tracer's own time per case);
 2. the table's build time per (g, albedo);
 3. the per-pixel cost the term adds, on both backends (the foggy street, 16 lamps).
 
@@ -44,7 +45,8 @@ def accuracy(renderer: airlight.Renderer) -> None:
         ss = np.array([v["airlight_single"] for v in case["views"]])
         keep = ref >= 1e-3 * ref[0]
         t0 = time.perf_counter()
-        got = np.array([float(renderer.render(ms_cases.view_scene(case, i))[0, 0, 1]) for i in range(len(ref))])
+        got = np.array([float(renderer.render(ms_cases.view_scene(case, i))[0, 0, 1])
+                        for i in range(len(ref))])
         seconds = time.perf_counter() - t0
         dev = np.abs(got - ref)[keep] / ref[keep]
         ok = (np.abs(got - ref) <= ms_cases.allowed_deviation(ref, err))[keep]
@@ -52,11 +54,13 @@ def accuracy(renderer: airlight.Renderer) -> None:
         inside += int(ok.sum()) if case["tau"] < 20 else 0
         ss_dev = np.abs(ss - ref)[keep] / ref[keep]
         print(f"| {name} | {int(keep.sum())} | {ok.mean():.2f} | {100 * np.median(dev):.1f} % | "
-              f"{100 * dev.max():.1f} % | {100 * ss_dev.max():.0f} % | {case['seconds']:.0f} | {seconds:.2f} |")
+              f"{100 * dev.max():.1f} % | {100 * ss_dev.max():.0f} % | {case['seconds']:.0f} | "
+              f"{seconds:.2f} |")
     print()
     measurable = sum(int((np.array([v['radiance'] for v in c['views']]) >=
                           1e-3 * c['views'][0]['radiance']).sum()) for c in cases.values() if c['tau'] < 20)
-    print(f"tau 0.5 to 5: {inside} of {measurable} views within ({inside / measurable:.3f}); all cases: {total}")
+    print(f"tau 0.5 to 5: {inside} of {measurable} views within ({inside / measurable:.3f}); "
+          f"all cases: {total}")
     print()
 
 
@@ -103,12 +107,13 @@ def per_pixel_cost(backends: list[str], width: int) -> None:
             off = frame_seconds(r, with_ms(scene, False), 3)
             on = frame_seconds(r, with_ms(scene, True), 3)
         added = (on - off) / (width * height) * 1e9
-        print(f"| {backend} ({r.backend}) | {1e3 * off:.1f} | {1e3 * on:.1f} | {added:.1f} | {added / lamps:.2f} |")
+        print(f"| {backend} | {1e3 * off:.1f} | {1e3 * on:.1f} | {added:.1f} | {added / lamps:.2f} |")
     print()
 
 
 def main() -> None:
-    parser = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
+    parser = argparse.ArgumentParser(description=__doc__,
+                                     formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--skip-gl", action="store_true")
     parser.add_argument("--width", type=int, default=320)
     args = parser.parse_args()
