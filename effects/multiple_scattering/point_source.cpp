@@ -387,7 +387,9 @@ Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<doub
     auto tau_at = [&](double X) {
         const double w = X * w_max;
         double tau = std::min(tau_min * std::exp(w), tau_lin * w);
-        for (int k = 0; k < 60; ++k) tau = std::max(tau - (std::log(tau / tau_min) + tau / tau_lin - w) / (1.0 / tau + 1.0 / tau_lin), 0.5 * tau);
+        for (int k = 0; k < 60; ++k)
+            tau =
+                std::max(tau - (std::log(tau / tau_min) + tau / tau_lin - w) / (1.0 / tau + 1.0 / tau_lin), 0.5 * tau);
         return tau;
     };
     const double log_gamma = std::log(1.0 + kPi / double(LAMP_MS_GAMMA0));
@@ -402,8 +404,8 @@ Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<doub
             const std::array<double, 3> l = point_source_radiance(field, tau, gamma);
             float* texel = &t.texels[size_t(i) * 4];
             for (int c = 0; c < 3; ++c)
-                texel[c] = float(std::max(l[size_t(c)] > 0.0 ? std::log(l[size_t(c)]) : -1e30,
-                                          double(LAMP_MS_LOG_FLOOR)));
+                texel[c] =
+                    float(std::max(l[size_t(c)] > 0.0 ? std::log(l[size_t(c)]) : -1e30, double(LAMP_MS_LOG_FLOOR)));
             texel[3] = 0.0f;
         },
         settings.threads);
@@ -421,7 +423,8 @@ std::shared_ptr<const Table2D> lamp_ms_table(const PointSourcePhase& phase, cons
     std::snprintf(buf, sizeof buf, "ray %.9g; a %.9g %.9g %.9g", phase.rayleigh_weight, albedo[0], albedo[1],
                   albedo[2]);
     key += buf;
-    return cache.get(key, [&] { return timed_build("lamp_ms_glow", [&] { return build_lamp_ms_table(phase, albedo); }); });
+    return cache.get(key,
+                     [&] { return timed_build("lamp_ms_glow", [&] { return build_lamp_ms_table(phase, albedo); }); });
 }
 
 }  // namespace airlight

@@ -48,16 +48,16 @@ struct PointSourceField {
     int nt = 0;
     double r_core = 0.0;
     double r_kill = 0.0;
-    double dlog_r = 0.0;    // log bins from r_core to r_switch ...
+    double dlog_r = 0.0;  // log bins from r_core to r_switch ...
     int n_log = 0;
     double r_switch = 0.0;  // ... then bins of width dr (J falls exponentially there)
     double dr = 0.0;
     long photons = 0;
     double collisions = 0.0;
     double seconds = 0.0;
-    std::array<std::vector<double>, 3> source;  // [channel][ir * nt + it]
+    std::array<std::vector<double>, 3> source;      // [channel][ir * nt + it]
     std::array<std::vector<double>, 3> log_source;  // log J, -inf where J = 0
-    std::array<std::vector<double>, 3> core;    // [channel][it]: f = R J inside R_core
+    std::array<std::vector<double>, 3> core;        // [channel][it]: f = R J inside R_core
     // The continuous bin coordinate of radius r >= r_core (bin i is [i, i + 1)) and bin i's inner edge.
     double bin_coordinate(double r) const;
     double bin_edge(int i) const;

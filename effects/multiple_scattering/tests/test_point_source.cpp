@@ -113,11 +113,13 @@ void check_seed_noise() {
                 const double a = point_source_radiance(f1, tau, deg * kPi / 180.0)[0];
                 const double b = point_source_radiance(f2, tau, deg * kPi / 180.0)[0];
                 worst = std::max(worst, std::abs(a - b) / (0.5 * (a + b)));
-                if (g_print) std::printf("  tau %5.1f gamma %5.1f: %.5g %.5g (%+.4f)\n", tau, deg, a, b, (a - b) / (0.5 * (a + b)));
+                if (g_print)
+                    std::printf("  tau %5.1f gamma %5.1f: %.5g %.5g (%+.4f)\n", tau, deg, a, b,
+                                (a - b) / (0.5 * (a + b)));
             }
         if (g_print)
-            std::printf("g %.2f: %ld photons, %.3g collisions, MC %.2f s, worst seed difference %.4f\n", g,
-                        f1.photons, f1.collisions, seconds, worst);
+            std::printf("g %.2f: %ld photons, %.3g collisions, MC %.2f s, worst seed difference %.4f\n", g, f1.photons,
+                        f1.collisions, seconds, worst);
     }
 }
 
@@ -140,7 +142,9 @@ void check_table_interpolation() {
                 const double fy = double(lamp_ms_y(float(gamma))) * (t.height - 1);
                 const int ix = std::min(int(fx), t.width - 2), iy = std::min(int(fy), t.height - 2);
                 const double ax = fx - ix, ay = fy - iy;
-                auto texel = [&](int x, int y) { return double(t.texels[(size_t(y) * size_t(t.width) + size_t(x)) * 4]); };
+                auto texel = [&](int x, int y) {
+                    return double(t.texels[(size_t(y) * size_t(t.width) + size_t(x)) * 4]);
+                };
                 const double log_l = (1 - ay) * ((1 - ax) * texel(ix, iy) + ax * texel(ix + 1, iy)) +
                                      ay * ((1 - ax) * texel(ix, iy + 1) + ax * texel(ix + 1, iy + 1));
                 const double want = point_source_radiance(field, tau, gamma)[0];
