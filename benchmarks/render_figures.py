@@ -17,6 +17,10 @@
   fields and buildings on a clear day, in heavy rain and in light rain
   (scenes/day_*.json, each saved by the demo with its own display settings:
   automatic exposure, filmic curve), side by side.
+- heavy_rain_multiple_scattering.png: the heavy-rain day (scenes/day_heavy_rain.json, 320 x 180)
+  at one fixed exposure (8, filmic curve) with single scattering only (left,
+  ``quality.multiple_scattering`` false: what airlight rendered before issue 18) and with
+  multiple scattering (right).
 - rainbows.png: the source paper's figure 7 (issue 7): after heavy rain and
   after light rain (scenes/rainbow_after_*.json, saved by the demo), side by
   side; rain_ends.png: the end of the heavy shower (airlight-demo --sequence
@@ -83,6 +87,19 @@ def day_weather_strip(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 
+def heavy_rain_before_after(backend: str, out: Path) -> None:
+    """day_heavy_rain without and with multiple scattering at the same fixed exposure."""
+    tiles = []
+    with airlight.Renderer(backend) as r:
+        for multiple in (False, True):
+            scene = airlight.preset("day_heavy_rain")
+            scene["quality"] = {"multiple_scattering": multiple}
+            radiance = r.render(scene, width=320, height=180)
+            tiles.append(airlight.display(radiance, exposure=8.0, tonemap="filmic"))
+            tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
+    Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
+
+
 def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
     """The two figure-7 presets side by side, and the rain-ends sequence as a strip."""
     with tempfile.TemporaryDirectory() as tmp:
@@ -107,9 +124,13 @@ def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
-    ap.add_argument("--only", choices=["rainbows"], help="render only these figures")
+    ap.add_argument("--only", choices=["rainbows", "daytime"], help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
+    if args.only == "daytime":
+        day_weather_strip(args.backend, IMAGES / "day_weather.png")
+        heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
+        return
     rainbow_figures(args.backend, IMAGES / "rainbows.png", IMAGES / "rain_ends.png")
     if args.only == "rainbows":
         return
@@ -121,6 +142,7 @@ def main() -> None:
          "loglog", "--glare", "--pupil", "4", "--eyelashes")
     approaching_car_strip(args.backend, IMAGES / "approaching_car.png")
     day_weather_strip(args.backend, IMAGES / "day_weather.png")
+    heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
     with airlight.Renderer(args.backend) as r:
         tiles = []
         for density in ("000", "001", "002", "004"):
@@ -131,7 +153,8 @@ def main() -> None:
         crane = r.render(airlight.preset("crane_searchlight"))
         airlight.save_png(IMAGES / "crane_searchlight.png", crane, exposure=0.1)
     print(f"wrote {IMAGES}/foggy_street.png, foggy_street_hg.png, spotlights_crossing.png, "
-          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png, day_weather.png, rainbows.png, "
+          "crane_searchlight.png, foggy_street_eye.png, approaching_car.png, day_weather.png, "
+          "heavy_rain_multiple_scattering.png, rainbows.png, "
           "rain_ends.png")
 
 

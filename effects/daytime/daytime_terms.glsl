@@ -10,11 +10,18 @@ vec3 sky_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
 }
 
 // Hook surface_irradiance: the sun's, where the point sees it (sun_visibility:
-// a shadow ray, or the map of effects/sun_shadow_map).
+// a shadow ray, or the map of effects/sun_shadow_map); with multiple
+// scattering, its forward-scattered residual beam E_res too, which travels
+// nearly along the sun and is shadowed with it
+// (effects/multiple_scattering/physics.md section 10).
 vec3 sun_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
-    if (!HAS_SUN || dot(n, vec3(frame.sky.sun_direction)) <= 0.0f) return vec3(0.0f);
+    float cos_n = dot(n, vec3(frame.sky.sun_direction));
+    if (!HAS_SUN || cos_n <= 0.0f) return vec3(0.0f);
     float visible = sun_visibility(p, n, self);
-    return visible > 0.0f ? visible * sun_irradiance(p, n) : vec3(0.0f);
+    if (visible <= 0.0f) return vec3(0.0f);
+    vec3 e = sun_irradiance(p, n);
+    if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) e += ms_sun_residual(ms_level(max(p.y, 0.0f))) * cos_n;
+    return visible * e;
 }
 
 // Hook escaping_radiance: the sky dome seen by a ray that meets nothing.

@@ -139,9 +139,13 @@ vec3 sun_irradiance(vec3 p, vec3 n) {
 // the exact sky-phase integral in place of the seed's effective phase
 // value): Lz F_i(C, d) (sky) + E_sun exp(-C / s_y) p_i(d . s) (sun), per
 // channel; kept apart because they change with C at different rates.
+// With multiple scattering (HAS_MULTIPLE_SCATTERING), a third part: the light
+// scattered at least once before, K_i(y, d) + E_res(y) p_i(d . s)
+// (effects/multiple_scattering/ms_field.glsl).
 struct SpeciesLight {
     vec3 sky[3];
     vec3 sun[3];
+    vec3 ms[3];
 };
 
 // Each species' phase function for the sun's light along a view ray, per
@@ -158,7 +162,7 @@ SunPhase sun_phase_along(vec3 d) {
     return p;
 }
 
-SpeciesLight species_light(SkyTableDirection t, vec3 column, SunPhase sun_phase) {
+SpeciesLight species_light(SkyTableDirection t, MsDirection ms_dir, float y, vec3 column, SunPhase sun_phase) {
     SpeciesLight out_light;
     vec4 k0 = vec4(0.0f);
     vec4 k1 = vec4(0.0f);
@@ -177,6 +181,15 @@ SpeciesLight species_light(SkyTableDirection t, vec3 column, SunPhase sun_phase)
     out_light.sun[0] = sun * sun_phase.species[SPECIES_MOLECULES];
     out_light.sun[1] = sun * sun_phase.species[SPECIES_AEROSOL];
     out_light.sun[2] = sun * sun_phase.species[SPECIES_RAIN];
+    for (int i = 0; i < 3; ++i) out_light.ms[i] = vec3(0.0f);
+    if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
+        MsLevel level = ms_level(y);
+        vec3 residual = HAS_SUN ? ms_sun_residual(level) : vec3(0.0f);
+        for (int i = 0; i < 3; ++i) {
+            if (species_present(i))
+                out_light.ms[i] = ms_phased_radiance(i, ms_dir, level) + residual * sun_phase.species[i];
+        }
+    }
     return out_light;
 }
 
@@ -191,7 +204,7 @@ void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigm
         SpeciesGpu sp = frame.species[i];
         float rho = piece_density(sp, profile_piece(sp, y_piece), y);
         sigma_t += vec3(sp.sigma_t) * rho;
-        j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i]);
+        j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i] + light.ms[i]);
     }
 }
 
@@ -366,6 +379,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
     SkyTableDirection t = sky_table_direction(d);
+    MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
     SunPhase sun_phase;
     for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
     if (HAS_SUN) sun_phase = sun_phase_along(d);
@@ -374,7 +388,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
     if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.top);
     float s_a = s_in;
     vec3 weight = exp(-sigma_medium * s_in);  // transmittance from the camera to s_a, medium included
-    SpeciesLight light_a = species_light(t, atmosphere_column(y_a), sun_phase);
+    SpeciesLight light_a = species_light(t, ms_dir, y_a, atmosphere_column(y_a), sun_phase);
     for (int step = 0; step < ATMOSPHERE_MAX_VOLUMES && s_a < s_out; ++step) {
         float s_b;
         float y_b;
@@ -392,7 +406,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
         vec3 tau = stretch_optical_depth(y_a, y_piece, mu, len);
         vec3 dtau = tau + sigma_medium * min(len, 1.0e30f);
         SpeciesLight light_b = light_a;
-        if (y_b != y_a) light_b = species_light(t, atmosphere_column(y_b), sun_phase);
+        if (y_b != y_a) light_b = species_light(t, ms_dir, y_b, atmosphere_column(y_b), sun_phase);
         // Each species' share of the source, sigma_s,i rho_i L_i / sigma_t,
         // its sky and sun parts each taken exponential in optical depth on
         // their own (effects/daytime/docs/daytime.md).
@@ -415,6 +429,10 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
             if (HAS_SUN) {
                 inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sun[i], sigma_a),
                                                        source_function(scale_b * light_b.sun[i], sigma_b));
+            }
+            if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
+                inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.ms[i], sigma_a),
+                                                       source_function(scale_b * light_b.ms[i], sigma_b));
             }
         }
         weight *= exp(-dtau);
@@ -472,6 +490,7 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
     float s_far = march_far_distance(o, d, s_in, s_out, sigma_medium);
     SkyTableDirection t = sky_table_direction(d);
+    MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
     SunPhase sun_phase;
     for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
     if (HAS_SUN) sun_phase = sun_phase_along(d);
@@ -483,7 +502,7 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
         float y = clamp(o.y + d.y * s, 0.0f, frame.atmosphere.top);
         vec3 sigma;
         vec3 j;
-        atmosphere_point(y, y, species_light(t, atmosphere_column(y), sun_phase), sigma, j);
+        atmosphere_point(y, y, species_light(t, ms_dir, y, atmosphere_column(y), sun_phase), sigma, j);
         inscatter += exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds)) *
                      j * ds;
         tau += sigma * ds;

@@ -24,9 +24,12 @@ SCRIPT = textwrap.dedent("""
 
 
 def base(**extra: object) -> dict:
+    """A small scene; multiple scattering is off, as these tests count the single-scattering
+    tables (the multiple-scattering field's: effects/multiple_scattering/tests)."""
     scene = {"film": {"width": 16, "height": 12},
              "camera": {"position": [0, 1.7, 0], "look_at": [0, 1.7, -10], "up": [0, 1, 0], "fov_y": 60},
-             "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]}
+             "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}],
+             "quality": {"multiple_scattering": False}}
     scene.update(extra)
     return scene
 

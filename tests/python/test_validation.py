@@ -197,6 +197,8 @@ BAD_SCENES = [
     ("sky_segments_too_few", _set("quality", {"sky_segments": 1}), ValueError, "quality.sky_segments"),
     ("sky_segments_too_many", _set("quality", {"sky_segments": 65}), ValueError, "quality.sky_segments"),
     ("sky_segments_float", _set("quality", {"sky_segments": 8.5}), ValueError, "quality.sky_segments"),
+    ("multiple_scattering_not_bool", _set("quality", {"multiple_scattering": 1}), TypeError,
+     "quality.multiple_scattering"),
     ("sky_not_object", _set("sky", "blue"), TypeError, "sky"),
     ("sky_type_on_overcast", _set("sky", {"model": "overcast", "type": 1, "zenith_radiance": 1}), ValueError,
      "sky.type"),
@@ -625,6 +627,7 @@ def test_issue_example_loads_with_defaults_filled_in() -> None:
     assert atmosphere["rain"] == {"rate": 10.0, "density_scale": 1.0, "top": 1500.0, "g": 0.87,
                                   "phase": "mie"}
     assert loaded["quality"]["sky_segments"] == 16
+    assert loaded["quality"]["multiple_scattering"] is True
     assert airlight.load_scene(loaded) == loaded
 
 
@@ -686,7 +689,8 @@ def _daytime_keys(draw) -> dict[str, Any]:
     if atmosphere or draw(st.booleans()):
         keys["atmosphere"] = atmosphere
     keys["quality"] = {"sky_segments": draw(st.integers(2, 64)),
-                       "rainbow_wavelengths": draw(st.sampled_from([3, 5, 9, 17, 33]))}
+                       "rainbow_wavelengths": draw(st.sampled_from([3, 5, 9, 17, 33])),
+                       "multiple_scattering": draw(st.booleans())}
     return keys
 
 
@@ -702,4 +706,5 @@ def test_random_daytime_keys_load_and_round_trip(keys) -> None:
         assert np.linalg.norm(loaded["sun"]["direction"]) == pytest.approx(1.0, abs=1e-6)
     assert loaded["quality"]["sky_segments"] == keys["quality"]["sky_segments"]
     assert loaded["quality"]["rainbow_wavelengths"] == keys["quality"]["rainbow_wavelengths"]
+    assert loaded["quality"]["multiple_scattering"] == keys["quality"]["multiple_scattering"]
     assert airlight.load_scene(loaded) == loaded

@@ -270,6 +270,8 @@ def _quality(d: _Draw) -> dict[str, Any] | None:
     if d.chance(0.3):
         q["rainbow_wavelengths"] = d.choice([3, 5, 9, 17, 33])
     if d.chance(0.3):
+        q["multiple_scattering"] = d.chance(0.5)
+    if d.chance(0.3):
         corners = [0, 16, 17, 64, 256, 1024, 4096]
         q["sun_shadow_map"] = d.choice(corners) if d.corner() else d.rng.randint(16, 512)
     return q

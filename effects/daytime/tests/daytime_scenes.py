@@ -46,11 +46,12 @@ def atmosphere(molecules: bool = True, visibility: float | None = None, rain: fl
 
 def day_scene(*, sky: dict | None = OVERCAST, sun: dict | None = None, atmosphere: dict | None = None,
               camera_y: float = 1.7, pitch: float = 0.0, fov: float = 90.0, width: int = 1, height: int = 12,
-              ground: float | None = None, **extra) -> dict:
+              ground: float | None = None, multiple_scattering: bool = False, **extra) -> dict:
     """A camera at altitude camera_y looking along -z tilted up by `pitch` degrees (straight up or
     down: the film's up is -z). `ground`: the albedo of a Lambertian plane at y = 0 (None: no
     surface, rays below the horizon end on the black ground). With pitch 0 and an odd height the
-    middle row is exactly horizontal."""
+    middle row is exactly horizontal. These scenes check single scattering against its quadrature
+    reference, so multiple scattering is off unless asked for (``quality`` in ``extra`` adds to it)."""
     p = math.radians(pitch)
     up = [0.0, 0.0, -1.0] if abs(pitch) > 89.9 else [0.0, 1.0, 0.0]
     camera = {"position": [0.0, camera_y, 0.0], "look_at": [0.0, camera_y + math.sin(p), -math.cos(p)],
@@ -64,7 +65,9 @@ def day_scene(*, sky: dict | None = OVERCAST, sun: dict | None = None, atmospher
         scene["atmosphere"] = atmosphere
     if ground is not None:
         scene["surfaces"] = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": ground}]
+    quality = {"multiple_scattering": multiple_scattering, **extra.pop("quality", {})}
     scene.update(extra)
+    scene["quality"] = quality
     return scene
 
 

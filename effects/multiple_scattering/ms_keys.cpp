@@ -1,5 +1,4 @@
-// PLACEHOLDER (branch ms-night; ms_quality_placeholder.hpp): the quality key
-// "multiple_scattering", a bool, default true.
+// The quality key "multiple_scattering" (EFFECT_QUALITY_KEYS; README "Scene format").
 #include "scene_keys.hpp"
 
 namespace airlight {

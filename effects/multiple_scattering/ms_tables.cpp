@@ -1,0 +1,308 @@
+// The multiple-scattering field as the shading pass reads it
+// (effects/multiple_scattering/physics.md section 10; ms_layout.glsl): the
+// plane-parallel solution of the scene's atmosphere, sky, sun and ground,
+// solved once per weather state and tabulated over the solver's levels.
+#include "ms_tables.hpp"
+
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstring>
+#include <string>
+
+#include "frame_data.hpp"
+#include "numerics.hpp"
+#include "sky.hpp"
+
+namespace airlight {
+
+using numerics::kPi;
+
+bool sky_lights_atmosphere(const shader::SkyGpu& sky) {
+    const bool dome = int(sky.zenith_radiance.w) != shader::SKY_NONE &&
+                      (sky.zenith_radiance.x > 0.0f || sky.zenith_radiance.y > 0.0f || sky.zenith_radiance.z > 0.0f);
+    return dome || sky.sun_direction.w != 0.0f;
+}
+
+double atmosphere_scattering_depth(const shader::SpeciesGpu species[shader::SPECIES_COUNT]) {
+    float top = 0.0f;
+    const std::vector<float> levels = make_altitude_levels(species, 2, top);
+    if (!(top > 0.0f)) return 0.0;
+    const SlabAtmosphere atm = slab_from_species(species, {0.0, double(top)});
+    double depth = 0.0;
+    for (int c = 0; c < 3; ++c) {
+        double d = 0.0;
+        for (const RgbD& s : atm.layers[0].scattering_depth) d += s[size_t(c)];
+        depth = std::max(depth, d);
+    }
+    return depth;
+}
+
+RgbD ground_albedo(const Scene& scene) {
+    for (const Surface& s : scene.surfaces) {
+        if (s.type != SurfaceType::plane) continue;
+        const glm::vec3 n = glm::normalize(s.normal);
+        if (n.y > 0.9999f && std::abs(s.point.y) <= MS_GROUND_TOLERANCE)
+            return {double(s.albedo.x), double(s.albedo.y), double(s.albedo.z)};
+    }
+    return {0.0, 0.0, 0.0};
+}
+
+// C_m(mu_n, mu) = int_0^{2 pi} cos(m psi) max(mu_n mu + s_n s cos psi, 0) dpsi
+// in closed form (effects/multiple_scattering/physics.md section 10): the
+// azimuthal weight of Fourier mode m of the radiance at cosine mu in the
+// irradiance of a surface whose normal has cosine mu_n.
+double clamped_cosine_mode(int m, double mu_n, double mu) {
+    const double a = mu_n * mu;
+    const double b = std::sqrt(std::max(0.0, 1.0 - mu_n * mu_n)) * std::sqrt(std::max(0.0, 1.0 - mu * mu));
+    if (b <= std::abs(a)) {
+        if (a <= 0.0) return 0.0;
+        return m == 0 ? 2.0 * kPi * a : (m == 1 ? kPi * b : 0.0);
+    }
+    const double psi0 = std::acos(std::clamp(-a / b, -1.0, 1.0));  // where the cosine turns negative
+    if (m == 0) return 2.0 * (a * psi0 + b * std::sin(psi0));
+    if (m == 1) return 2.0 * (a * std::sin(psi0) + 0.5 * b * (psi0 + 0.5 * std::sin(2.0 * psi0)));
+    return 2.0 * (a * std::sin(m * psi0) / m +
+                  0.5 * b * (std::sin((m - 1) * psi0) / (m - 1) + std::sin((m + 1) * psi0) / (m + 1)));
+}
+
+namespace {
+
+// The table's layout (ms_layout.glsl) for a field.
+struct FieldLayout {
+    int levels = 0;
+    int view_azimuths = 1;
+    int normal_azimuths = 1;
+    int irradiance_row = 0;
+    int residual_row = 0;
+    int altitude_row = 0;
+    int rows = 0;
+};
+
+FieldLayout field_layout(int levels, bool azimuth) {
+    FieldLayout l;
+    l.levels = levels;
+    l.view_azimuths = azimuth ? shader::MS_VIEW_AZIMUTHS : 1;
+    l.normal_azimuths = azimuth ? shader::MS_NORMAL_AZIMUTHS : 1;
+    l.irradiance_row = shader::SPECIES_COUNT * shader::MS_VIEW_ELEVATIONS * l.view_azimuths;
+    l.residual_row = l.irradiance_row + shader::MS_NORMAL_ELEVATIONS * l.normal_azimuths;
+    l.altitude_row = l.residual_row + 1;
+    l.rows = l.altitude_row + 1;
+    return l;
+}
+
+// Uniform nodes over [a, b] (n >= 2; one node at a when n = 1).
+std::vector<double> uniform_nodes(double a, double b, int n) {
+    std::vector<double> v(size_t(n), a);
+    for (int k = 1; k < n; ++k) v[size_t(k)] = a + (b - a) * k / (n - 1);
+    return v;
+}
+
+std::string field_key(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                      const RgbD& ground, int segments) {
+    std::string key(reinterpret_cast<const char*>(&sky), sizeof(sky));
+    key.append(reinterpret_cast<const char*>(species), sizeof(shader::SpeciesGpu) * shader::SPECIES_COUNT);
+    key.append(reinterpret_cast<const char*>(ground.data()), sizeof(double) * 3);
+    key.append(reinterpret_cast<const char*>(&segments), sizeof(segments));
+    return key;
+}
+
+Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                          const RgbD& ground, int segments) {
+    const auto start = std::chrono::steady_clock::now();
+    // Levels: the solver's (slab_levels), at most MS_MAX_LEVELS (thicker
+    // layers where a very dense atmosphere needs more).
+    double depth = MS_LAYER_DEPTH;
+    std::vector<double> levels = slab_levels(species, segments, depth);
+    while (levels.size() > size_t(shader::MS_MAX_LEVELS)) {
+        depth *= 2.0;
+        levels = slab_levels(species, segments, depth);
+    }
+    const SlabAtmosphere atm = slab_from_species(species, levels);
+    const SlabIllumination light = slab_illumination(sky, ground);
+    const bool azimuth = sky.sun_direction.w != 0.0f || sky_has_azimuth(sky);
+    const FieldLayout layout = field_layout(int(levels.size()), azimuth);
+    SolverOptions options;
+    options.streams = MS_STREAMS;
+    options.threads = numerics::worker_count(3);
+    for (int k = 0; k < shader::MS_VIEW_ELEVATIONS; ++k)
+        options.view_mu.push_back(std::sin(-0.5 * kPi + kPi * k / (shader::MS_VIEW_ELEVATIONS - 1)));
+    options.view_phi = uniform_nodes(0.0, kPi, layout.view_azimuths);
+    const MultipleScatteringField field = solve_plane_parallel(atm, light, options);
+
+    Table2D t;
+    t.width = layout.levels;
+    t.height = layout.rows;
+    t.channels = 4;
+    t.texels.assign(size_t(t.width) * size_t(t.height) * 4, 0.0f);
+    auto texel = [&](int level, int row) { return &t.texels[(size_t(row) * size_t(t.width) + size_t(level)) * 4]; };
+    const std::array<double, 3> sun = look_direction(field.sun_mu, 0.0);
+    // K_i without the residual beam (ms_field.glsl adds E_res p_i(d . s) with the renderer's own sun phase).
+    int solver_species = 0;
+    for (int i = 0; i < shader::SPECIES_COUNT; ++i) {
+        if (species[i].phase.z == 0.0f) continue;
+        const PhaseFunction& phase = atm.phases[size_t(solver_species)];
+        for (int ia = 0; ia < layout.view_azimuths; ++ia)
+            for (int ie = 0; ie < shader::MS_VIEW_ELEVATIONS; ++ie) {
+                const std::array<double, 3> d = look_direction(field.view_mu[size_t(ie)], field.view_phi[size_t(ia)]);
+                const double p_sun =
+                    field.sun_mu > 0.0 ? phase.value(d[0] * sun[0] + d[1] * sun[1] + d[2] * sun[2]) / (4.0 * kPi) : 0.0;
+                const int row = (i * layout.view_azimuths + ia) * shader::MS_VIEW_ELEVATIONS + ie;
+                for (int lev = 0; lev < layout.levels; ++lev)
+                    for (int c = 0; c < 3; ++c)
+                        texel(lev, row)[c] = float(field.phased(lev, solver_species, c, ie, ia) -
+                                                   p_sun * field.sun_forward_irradiance[size_t(lev)][size_t(c)]);
+            }
+        ++solver_species;
+    }
+    // E(y, n) from the ordinates' Fourier modes, the azimuth integrated in
+    // closed form (clamped_cosine_mode): sum_j w_j sum_m (a_m cos m phi_n +
+    // b_m sin m phi_n) C_m(mu_n, mu_j) over both hemispheres.
+    const int n = field.streams, modes = field.modes_solved;
+    const std::vector<double> normal_phi = uniform_nodes(0.0, kPi, layout.normal_azimuths);
+    for (int ie = 0; ie < shader::MS_NORMAL_ELEVATIONS; ++ie) {
+        const double mu_n = std::sin(-0.5 * kPi + kPi * ie / (shader::MS_NORMAL_ELEVATIONS - 1));
+        std::vector<double> weight(size_t(2 * n) * size_t(modes));  // w_j C_m(mu_n, mu_node)
+        for (int node = 0; node < 2 * n; ++node) {
+            const int j = node % n;
+            const double mu = node < n ? field.node_mu[size_t(j)] : -field.node_mu[size_t(j)];
+            for (int m = 0; m < modes; ++m)
+                weight[size_t(node) * size_t(modes) + size_t(m)] =
+                    field.node_weight[size_t(j)] * clamped_cosine_mode(m, mu_n, mu);
+        }
+        for (int ia = 0; ia < layout.normal_azimuths; ++ia) {
+            const double phi_n = normal_phi[size_t(ia)];
+            const int row = layout.irradiance_row + ia * shader::MS_NORMAL_ELEVATIONS + ie;
+            for (int lev = 0; lev < layout.levels; ++lev)
+                for (int c = 0; c < 3; ++c) {
+                    double e = 0.0;
+                    for (int node = 0; node < 2 * n; ++node)
+                        for (int m = 0; m < modes; ++m)
+                            e += weight[size_t(node) * size_t(modes) + size_t(m)] *
+                                 (field.node_radiance[field.node_index(lev, c, m, node, 0)] * std::cos(m * phi_n) +
+                                  field.node_radiance[field.node_index(lev, c, m, node, 1)] * std::sin(m * phi_n));
+                    texel(lev, row)[c] = float(e);
+                }
+        }
+    }
+    for (int lev = 0; lev < layout.levels; ++lev) {
+        for (int c = 0; c < 3; ++c)
+            texel(lev, layout.residual_row)[c] = float(field.sun_forward_irradiance[size_t(lev)][size_t(c)]);
+        texel(lev, layout.altitude_row)[0] = float(field.altitudes[size_t(lev)]);
+    }
+    t.name = "ms_field";
+    t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return t;
+}
+
+}  // namespace
+
+std::shared_ptr<const Table2D> multiple_scattering_table(const shader::SkyGpu& sky,
+                                                         const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                                         const RgbD& ground, int segments) {
+    static TableCache<std::string> cache(4);  // the last 4 weather states
+    return cache.get(field_key(sky, species, ground, segments),
+                     [&] { return build_field_table(sky, species, ground, segments); });
+}
+
+namespace {
+
+// The ground's reflection alone (effects/multiple_scattering/physics.md
+// section 10): in an atmosphere too thin to scatter, the diffuse light is the
+// ground's Lambertian radiance rho E_0 / pi from below the horizon, so a
+// surface of normal n receives rho E_0 (1 - n_y) / 2, E_0 the sun's and the
+// sky's unscattered irradiance on the ground (through the column C(0)).
+Table2D build_ground_bounce_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                  const RgbD& ground, const glm::dvec3& column) {
+    const auto start = std::chrono::steady_clock::now();
+    const FieldLayout layout = field_layout(2, false);
+    Table2D t;
+    t.width = layout.levels;
+    t.height = layout.rows;
+    t.channels = 4;
+    t.texels.assign(size_t(t.width) * size_t(t.height) * 4, 0.0f);
+    RgbD e0{};
+    const double sun_y = double(sky.sun_direction.y);
+    for (int c = 0; c < 3; ++c) {
+        double e = 0.0;
+        if (sky.sun_direction.w != 0.0f && sun_y > 0.0)
+            e += double(sky.sun_irradiance[c]) * sun_y * std::exp(-column[c] / sun_y);
+        if (int(sky.zenith_radiance.w) != shader::SKY_NONE)
+            e += double(sky.zenith_radiance[c]) * sky_kernel_integral(sky, species, 3, column[c], glm::dvec3(0, 1, 0));
+        e0[size_t(c)] = e;
+    }
+    for (int ie = 0; ie < shader::MS_NORMAL_ELEVATIONS; ++ie) {
+        const double n_y = std::sin(-0.5 * kPi + kPi * ie / (shader::MS_NORMAL_ELEVATIONS - 1));
+        for (int lev = 0; lev < layout.levels; ++lev)
+            for (int c = 0; c < 3; ++c)
+                t.texels[(size_t(layout.irradiance_row + ie) * size_t(t.width) + size_t(lev)) * 4 + size_t(c)] =
+                    float(ground[size_t(c)] * e0[size_t(c)] * 0.5 * (1.0 - n_y));
+    }
+    // Levels at the ground and far above: the same light at every altitude.
+    t.texels[(size_t(layout.altitude_row) * size_t(t.width) + 1) * 4] = MS_GROUND_BOUNCE_TOP;
+    t.name = "ms_ground_bounce";
+    t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return t;
+}
+
+}  // namespace
+
+std::shared_ptr<const Table2D> ground_bounce_table(const shader::SkyGpu& sky,
+                                                   const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                                   const RgbD& ground, const glm::dvec3& column) {
+    static TableCache<std::string> cache(4);
+    std::string key = field_key(sky, species, ground, 0);
+    key.append(reinterpret_cast<const char*>(&column), sizeof(column));
+    return cache.get(key, [&] { return build_ground_bounce_table(sky, species, ground, column); });
+}
+
+bool has_surface_besides_ground(const Scene& scene) {
+    for (const Surface& s : scene.surfaces) {
+        const bool ground = s.type == SurfaceType::plane && glm::normalize(s.normal).y > 0.9999f &&
+                            std::abs(s.point.y) <= MS_GROUND_TOLERANCE;
+        if (!ground) return true;
+    }
+    return false;
+}
+
+void pick_multiple_scattering_tables(const Scene& scene, FrameData& data) {
+    data.features.multiple_scattering = false;
+    shader::FrameUniforms& f = data.frame;
+    f.multiple_scattering = shader::MultipleScatteringGpu{};
+    if (!scene.quality.multiple_scattering || !sky_lights_atmosphere(f.sky)) return;
+    // The air's scattering is skipped where it cannot matter: no atmosphere,
+    // or one whose vertical optical depth of scattering is below
+    // MS_MIN_SCATTERING_DEPTH in every channel. The ground's reflection onto
+    // other surfaces is kept (ground_bounce_table) where a surface can see it.
+    const bool air = data.features.atmosphere && atmosphere_scattering_depth(f.species) >= MS_MIN_SCATTERING_DEPTH;
+    const RgbD ground = ground_albedo(scene);
+    const bool bounce = (ground[0] > 0.0 || ground[1] > 0.0 || ground[2] > 0.0) && has_surface_besides_ground(scene);
+    if (!air && !bounce) return;
+    std::shared_ptr<const Table2D> table;
+    if (air) {
+        table = multiple_scattering_table(f.sky, f.species, ground, scene.quality.sky_segments);
+    } else {
+        glm::dvec3 column(0.0);
+        if (data.features.atmosphere) {
+            const SlabAtmosphere slab = slab_from_species(f.species, {0.0, 1e30});
+            for (const RgbD& t : slab.layers[0].extinction_depth)
+                for (int c = 0; c < 3; ++c) column[c] += t[size_t(c)];
+        }
+        table = ground_bounce_table(f.sky, f.species, ground, column);
+    }
+    data.features.multiple_scattering = true;
+    const bool azimuth = table->height > field_layout(table->width, false).rows;
+    const FieldLayout layout = field_layout(table->width, azimuth);
+    f.multiple_scattering.air_scattering = air ? 1.0f : 0.0f;
+    f.multiple_scattering.level_count = float(layout.levels);
+    f.multiple_scattering.view_azimuths = float(layout.view_azimuths);
+    f.multiple_scattering.normal_azimuths = float(layout.normal_azimuths);
+    f.multiple_scattering.irradiance_row = float(layout.irradiance_row);
+    f.multiple_scattering.residual_row = float(layout.residual_row);
+    for (int k = 0; k < layout.levels; ++k)
+        f.multiple_scattering.levels[k / 4][k % 4] =
+            table->texels[(size_t(layout.altitude_row) * size_t(table->width) + size_t(k)) * 4];
+    data.use_table(shader::TABLE_MS_FIELD, table);
+}
+
+}  // namespace airlight
