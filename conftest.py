@@ -45,6 +45,8 @@ def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: 
 
     def single_scattering(scene: Any, width: Any, height: Any) -> Any:
         source = original(off(scene) if isinstance(scene, dict) else scene, width, height)
+        if isinstance(source, dict):  # JSON text or a file with the film overridden
+            return off(source)
         if isinstance(source, str):  # JSON text or a file's text
             try:
                 data = json.loads(source)
