@@ -96,7 +96,7 @@ constexpr double kCoreRadius = 0.02;   // optical: the pooled core, J = f / R (s
 constexpr double kSwitchRadius = 1.0;  // log bins below, linear above
 constexpr double kLinearBin = 0.2;
 constexpr double kWeightFloor = 1.0e-3;
-constexpr double kSurvival = 0.1;  // Russian roulette below the weight floor
+constexpr double kSurvival = 0.1;    // Russian roulette below the weight floor
 constexpr int kBatchPhotons = 1024;  // a group of 8 batches between budget checks: an albedo-1 walk
 constexpr int kGroupBatches = 8;     // of ~3000 collisions per photon overshoots the budget little
 
