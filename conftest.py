@@ -6,6 +6,7 @@ reference implementations beside it (and the core's helpers) by name."""
 from __future__ import annotations
 
 import copy
+import json
 import sys
 from pathlib import Path
 from typing import Any, Callable
@@ -21,6 +22,41 @@ for _dir in TEST_DIRS:
         sys.path.insert(0, str(_dir))
 
 BACKENDS = ("cpu", "gl")
+
+# Issue 18 turned multiple scattering on by default (quality.multiple_scattering). The tests written
+# before it check the single-scattering renderer against single-scattering references, so a scene dict
+# rendered outside effects/multiple_scattering/ renders with it off unless the scene sets it.
+MULTIPLE_SCATTERING_TESTS = ROOT / "effects" / "multiple_scattering"
+
+
+@pytest.fixture(autouse=True)
+def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    if Path(str(request.fspath)).resolve().is_relative_to(MULTIPLE_SCATTERING_TESTS):
+        return
+    from airlight import _rendering
+
+    original = _rendering._with_film_size
+
+    def off(scene: Any) -> Any:
+        quality = scene.get("quality")
+        if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
+            scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
+        return scene
+
+    def single_scattering(scene: Any, width: Any, height: Any) -> Any:
+        source = original(off(scene) if isinstance(scene, dict) else scene, width, height)
+        if isinstance(source, dict):  # JSON text or a file with the film overridden
+            return off(source)
+        if isinstance(source, str):  # JSON text or a file's text
+            try:
+                data = json.loads(source)
+            except (ValueError, RecursionError):
+                return source  # the validator names the error
+            if isinstance(data, dict):
+                return json.dumps(off(data))
+        return source
+
+    monkeypatch.setattr(_rendering, "_with_film_size", single_scattering)
 
 
 def skip_unless_backend_available(backend: str) -> None:

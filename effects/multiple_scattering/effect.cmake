@@ -18,3 +18,17 @@ set(EFFECT_GLSL_PIXEL ms_field.glsl)
 set(EFFECT_GLSL_TERMS ms_terms.glsl)
 set(EFFECT_HOOKS
     surface_irradiance=ms_surface_irradiance)  # the diffuse sky light on surfaces
+
+# ---- Night (issue 18): point lamps' multiple scattering in the homogeneous
+# medium (physics.md sections 12 to 14; effects/multiple_scattering/docs/lamps.md),
+# switched by the same quality.multiple_scattering.
+list(APPEND EFFECT_SOURCES point_source.cpp lamp_ms_frame.cpp ms_frame.cpp)
+list(APPEND EFFECT_GLSL_MATH lamp_ms_math.glsl)
+list(APPEND EFFECT_GLSL_TERMS lamp_ms_terms.glsl)
+list(APPEND EFFECT_FEATURES
+    lamp_multiple_scattering=LAMP_MULTIPLE_SCATTERING)  # point lamps: light scattered twice or more
+list(APPEND EFFECT_TABLES
+    lamp_ms_glow)  # log L(tau, gamma) per albedo channel (lamp_ms_math.glsl)
+list(APPEND EFFECT_HOOKS
+    view_glow=lamp_ms_view_glow)
+set(EFFECT_FRAME 1)  # ms_frame.cpp: pack_multiple_scattering_frame (the lamps' switch and table)

@@ -1,0 +1,53 @@
+// The point lamps' multiple scattering in the homogeneous medium
+// (effects/multiple_scattering/physics.md sections 12 to 14), added to their
+// exact single scattering (effects/lamp_airlight/lamp_terms.glsl): hook view_glow.
+
+// One channel of the field: exp(log_scale) L(tau, gamma) with the table's log L
+// (lamp_ms_math.glsl); no light at or beyond LAMP_MS_TAU_MAX (section 14).
+float lamp_ms_channel(int channel, float log_scale, float tau, float y) {
+    if (tau >= LAMP_MS_TAU_MAX) return 0.0f;
+    vec4 t = table_bilinear4(TABLE_LAMP_MS_GLOW, LAMP_MS_NX, LAMP_MS_NY, lamp_ms_x(tau), y);
+    float log_l = channel == 0 ? t.x : (channel == 1 ? t.y : t.z);
+    return exp(log_scale + log_l);
+}
+
+// The radiance of lamp `light`'s light scattered at least twice arriving at
+// point q from direction dir (looking along dir), times exp(-sigma_t t):
+// I sigma_t^2 e^{-sigma_t t} L(sigma_t R, gamma) per channel (section 13), R the
+// distance from q to the lamp, gamma the angle between dir and the lamp's direction.
+vec3 lamp_ms_field(PointLightGpu light, vec3 q, vec3 dir, float t) {
+    vec3 v = vec3(light.position_radius) - q;
+    float dist = length(v);
+    float gamma = atan(length(cross(dir, v)), dot(dir, v));
+    float y = lamp_ms_y(gamma);
+    vec3 sigma_t = vec3(frame.sigma_t);
+    vec3 intensity = vec3(light.intensity);
+    if (GREY_MEDIUM) {
+        // One lookup; the channels differ by I only (the table's channels hold one albedo).
+        float peak = max(max(intensity.x, intensity.y), intensity.z);
+        if (peak <= 0.0f || sigma_t.x <= 0.0f) return vec3(0.0f);
+        float log_scale = log(peak) + 2.0f * log(sigma_t.x) - sigma_t.x * t;
+        return (intensity / peak) * lamp_ms_channel(0, log_scale, sigma_t.x * dist, y);
+    }
+    vec3 field = vec3(0.0f);
+    for (int c = 0; c < 3; ++c) {
+        if (intensity[c] <= 0.0f || sigma_t[c] <= 0.0f) continue;
+        field[c] = lamp_ms_channel(c, log(intensity[c]) + 2.0f * log(sigma_t[c]) - sigma_t[c] * t, sigma_t[c] * dist, y);
+    }
+    return field;
+}
+
+// Hook view_glow: every lamp's multiply scattered light over [0, t_hit]: the
+// field at the camera less the field beyond the hit point seen through the
+// segment (section 13; surfaces neither block nor reflect the diffuse light).
+vec3 lamp_ms_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
+    if (!LAMP_MULTIPLE_SCATTERING) return radiance;
+    vec3 sum = vec3(0.0f);
+    for (int i = 0; i < point_light_count(); ++i) {
+        PointLightGpu light = point_light(i);
+        vec3 glow = lamp_ms_field(light, origin, dir, 0.0f);
+        if (t_hit < NO_HIT) glow -= lamp_ms_field(light, origin + t_hit * dir, dir, t_hit);
+        sum += max(glow, vec3(0.0f));
+    }
+    return radiance + sum;
+}

@@ -1,0 +1,89 @@
+// Multiple scattering of an isotropic point lamp in an infinite homogeneous
+// medium (effects/multiple_scattering/physics.md sections 12 to 14): the
+// radiance field of the light scattered at least twice, built by a seeded
+// Monte Carlo of the in-scattering source and a line integral per table entry,
+// and the table the shading pass reads (effects/multiple_scattering/lamp_ms_math.glsl).
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <memory>
+#include <vector>
+
+#include "airlight/scene.hpp"
+#include "tables.hpp"
+
+namespace airlight {
+
+// The medium's phase function as a mixture of Henyey-Greenstein lobes and a
+// Rayleigh part (weights summing to 1; isotropic: one HG lobe with g = 0).
+struct PointSourcePhase {
+    struct Lobe {
+        double g = 0.0;
+        double weight = 1.0;
+    };
+    std::vector<Lobe> hg;
+    double rayleigh_weight = 0.0;
+    double mean_cosine() const;
+};
+PointSourcePhase point_source_phase(const Phase& phase);
+
+// The Monte Carlo's settings: it traces batches of photons until it has
+// counted `collision_budget` collisions (or `max_photons` photons); the result
+// depends on seed and budget only, not on the number of threads.
+struct PointSourceSettings {
+    double collision_budget = 2.0e7;
+    long max_photons = 4000000;
+    uint64_t seed = 18;
+    int threads = 0;
+};
+
+// The in-scattering source of order >= 2, J(R, theta) (section 13), in optical
+// units (sigma_t = 1) for a lamp of unit intensity, per albedo channel: bins
+// over log R (R_core to R_switch), then R (to R_kill) and x = sqrt(theta / pi), theta the angle
+// between the light's propagation direction and the outward radial. Inside
+// R_core J = f(theta) / R (section 13).
+struct PointSourceField {
+    int nr = 0;
+    int nt = 0;
+    double r_core = 0.0;
+    double r_kill = 0.0;
+    double dlog_r = 0.0;  // log bins from r_core to r_switch ...
+    int n_log = 0;
+    double r_switch = 0.0;  // ... then bins of width dr (J falls exponentially there)
+    double dr = 0.0;
+    long photons = 0;
+    double collisions = 0.0;
+    double seconds = 0.0;
+    std::array<std::vector<double>, 3> source;      // [channel][ir * nt + it]
+    std::array<std::vector<double>, 3> log_source;  // log J, -inf where J = 0
+    std::array<std::vector<double>, 3> core;        // [channel][it]: f = R J inside R_core
+    // The continuous bin coordinate of radius r >= r_core (bin i is [i, i + 1)) and bin i's inner edge.
+    double bin_coordinate(double r) const;
+    double bin_edge(int i) const;
+    // J at distance R (optical) and cos theta, channel c (bilinear between bin centres).
+    double at(int c, double r, double cos_theta) const;
+};
+
+PointSourceField point_source_field(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
+                                    const PointSourceSettings& settings = {});
+
+// The multiply scattered radiance (optical units, unit intensity) seen from a
+// point at optical distance tau from the lamp, looking at angle gamma from
+// the direction to the lamp: L = int_0^inf e^{-s} J(R(s), theta(s)) ds (section 13),
+// per channel.
+std::array<double, 3> point_source_radiance(const PointSourceField& field, double tau, double gamma);
+
+// The table of log L over (tau, gamma) (lamp_ms_math.glsl's coordinates),
+// RGBA texels: one albedo per channel.
+Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
+                            const PointSourceSettings& settings = {});
+
+// The same, cached for the last 8 (phase, albedo) keys.
+std::shared_ptr<const Table2D> lamp_ms_table(const PointSourcePhase& phase, const std::array<double, 3>& albedo);
+
+// The azimuthal mean of the phase function, (1 / 2 pi) int p(cos theta_i cos theta_o +
+// sin theta_i sin theta_o cos phi) dphi (section 13; HG through the complete elliptic integral).
+double azimuthal_phase(const PointSourcePhase& phase, double cos_i, double cos_o);
+
+}  // namespace airlight

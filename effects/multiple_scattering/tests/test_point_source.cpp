@@ -1,0 +1,185 @@
+// The point lamp's multiple-scattering builder (effects/multiple_scattering/point_source.cpp,
+// physics.md sections 12 to 14): the azimuthal phase mean against brute-force
+// quadrature and its normalisation, energy conservation of the Monte Carlo
+// source (every order >= 2 scattering of an infinite medium: 4 pi a^2 / (1 - a)),
+// results independent of the thread count, the seed noise of the table, and
+// its build time. Run with --analysis to print the timings and noise.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <cstdio>
+#include <cstring>
+
+#include "check.hpp"
+#include "point_source.hpp"
+#include "shader_cpp.hpp"
+
+using namespace airlight;
+
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+bool g_print = false;
+
+PointSourcePhase hg(double g) {
+    PointSourcePhase p;
+    p.hg.push_back({g, 1.0});
+    return p;
+}
+
+double hg_value(double g, double mu) { return (1.0 - g * g) / (4.0 * kPi * std::pow(1.0 + g * g - 2.0 * g * mu, 1.5)); }
+
+void check_azimuthal_phase() {
+    for (double g : {0.0, 0.5, 0.9, -0.7}) {
+        for (double ci : {0.99, 0.3, -0.6}) {
+            for (double co : {0.95, 0.1, -0.9}) {
+                const double si = std::sqrt(1 - ci * ci), so = std::sqrt(1 - co * co);
+                double brute = 0.0;
+                const int n = 200000;
+                for (int k = 0; k < n; ++k) {
+                    const double phi = 2.0 * kPi * (k + 0.5) / n;
+                    brute += hg_value(g, ci * co + si * so * std::cos(phi)) / n;
+                }
+                const double got = azimuthal_phase(hg(g), ci, co);
+                CHECK_MSG(std::abs(got - brute) <= 1e-9 + 1e-7 * brute, std::to_string(g));
+            }
+        }
+        // Normalised: int pbar(ci, co) 2 pi dco = 1.
+        double sum = 0.0;
+        const int n = 400000;
+        for (int k = 0; k < n; ++k) {
+            const double co = -1.0 + 2.0 * (k + 0.5) / n;
+            sum += azimuthal_phase(hg(g), 0.2, co) * 2.0 * kPi * 2.0 / n;
+        }
+        CHECK_MSG(std::abs(sum - 1.0) < 1e-4, std::to_string(sum));
+    }
+    PointSourcePhase rayleigh;
+    rayleigh.rayleigh_weight = 1.0;
+    CHECK(std::abs(azimuthal_phase(rayleigh, 1.0, 1.0) - 3.0 / (8.0 * kPi)) < 1e-12);
+}
+
+// Sum over the field of J dV dOmega: the power scattered at orders >= 2.
+double field_power(const PointSourceField& f, int c) {
+    double total = 0.0;
+    for (int j = 0; j < f.nt; ++j) {
+        const double x0 = double(j) / f.nt, x1 = double(j + 1) / f.nt;
+        const double omega = 2.0 * kPi * (std::cos(kPi * x0 * x0) - std::cos(kPi * x1 * x1));
+        total += f.core[size_t(c)][size_t(j)] * 2.0 * kPi * f.r_core * f.r_core * omega;
+        for (int i = 0; i < f.nr; ++i) {
+            const double r0 = f.bin_edge(i), r1 = f.bin_edge(i + 1);
+            total += f.source[size_t(c)][size_t(i) * size_t(f.nt) + size_t(j)] * 4.0 / 3.0 * kPi *
+                     (r1 * r1 * r1 - r0 * r0 * r0) * omega;
+        }
+    }
+    return total;
+}
+
+void check_energy() {
+    PointSourceSettings s;
+    s.collision_budget = 2e6;
+    for (double g : {0.0, 0.9}) {
+        const std::array<double, 3> albedo = {0.5, 0.8, 0.0};
+        const PointSourceField f = point_source_field(hg(g), albedo, s);
+        for (int c = 0; c < 3; ++c) {
+            const double a = albedo[size_t(c)], want = 4.0 * kPi * a * a / (1.0 - a), got = field_power(f, c);
+            if (g_print) std::printf("energy g %.2f a %.2f: %.5f want %.5f\n", g, a, got, want);
+            CHECK_MSG(a == 0.0 ? got == 0.0 : std::abs(got / want - 1.0) < 0.01, std::to_string(got));
+        }
+    }
+}
+
+void check_threads_do_not_matter() {
+    PointSourceSettings one, two;
+    one.collision_budget = two.collision_budget = 1e6;
+    one.threads = 1;
+    two.threads = 2;
+    const PointSourceField a = point_source_field(hg(0.5), {0.9, 0.9, 0.9}, one);
+    const PointSourceField b = point_source_field(hg(0.5), {0.9, 0.9, 0.9}, two);
+    CHECK(a.photons == b.photons && a.source[0] == b.source[0] && a.core[1] == b.core[1]);
+}
+
+// Two seeds: the radiance at a few (tau, gamma) differs by the table's noise (printed).
+void check_seed_noise() {
+    for (double g : {0.0, 0.95}) {
+        PointSourceSettings s1, s2;
+        s2.seed = 1234;
+        const auto t0 = std::chrono::steady_clock::now();
+        const PointSourceField f1 = point_source_field(hg(g), {0.9, 0.9, 0.9}, s1);
+        const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+        const PointSourceField f2 = point_source_field(hg(g), {0.9, 0.9, 0.9}, s2);
+        double worst = 0.0;
+        for (double tau : {0.5, 2.0, 5.0, 20.0})
+            for (double deg : {0.5, 5.0, 30.0, 90.0, 180.0}) {
+                const double a = point_source_radiance(f1, tau, deg * kPi / 180.0)[0];
+                const double b = point_source_radiance(f2, tau, deg * kPi / 180.0)[0];
+                worst = std::max(worst, std::abs(a - b) / (0.5 * (a + b)));
+                if (g_print)
+                    std::printf("  tau %5.1f gamma %5.1f: %.5g %.5g (%+.4f)\n", tau, deg, a, b,
+                                (a - b) / (0.5 * (a + b)));
+            }
+        if (g_print)
+            std::printf("g %.2f: %ld photons, %.3g collisions, MC %.2f s, worst seed difference %.4f\n", g, f1.photons,
+                        f1.collisions, seconds, worst);
+    }
+}
+
+// The table's bilinear interpolation of log L (as the shader does it, lamp_ms_math.glsl's coordinates)
+// against the field's own line integral at points between the nodes.
+void check_table_interpolation() {
+    using namespace shader;
+    PointSourceSettings s;
+    s.collision_budget = 4e6;
+    for (double g : {0.0, 0.9}) {
+        const PointSourcePhase phase = hg(g);
+        const PointSourceField field = point_source_field(phase, {0.9, 0.9, 0.9}, s);
+        const Table2D t = build_lamp_ms_table(phase, {0.9, 0.9, 0.9}, s);
+        double worst = 0.0, sum = 0.0;
+        int count = 0;
+        for (double tau : {0.013, 0.37, 1.7, 4.3, 11.0, 27.0})
+            for (double deg : {0.7, 3.3, 13.0, 41.0, 97.0, 163.0}) {
+                const double gamma = deg * kPi / 180.0;
+                const double fx = double(lamp_ms_x(float(tau))) * (t.width - 1);
+                const double fy = double(lamp_ms_y(float(gamma))) * (t.height - 1);
+                const int ix = std::min(int(fx), t.width - 2), iy = std::min(int(fy), t.height - 2);
+                const double ax = fx - ix, ay = fy - iy;
+                auto texel = [&](int x, int y) {
+                    return double(t.texels[(size_t(y) * size_t(t.width) + size_t(x)) * 4]);
+                };
+                const double log_l = (1 - ay) * ((1 - ax) * texel(ix, iy) + ax * texel(ix + 1, iy)) +
+                                     ay * ((1 - ax) * texel(ix, iy + 1) + ax * texel(ix + 1, iy + 1));
+                const double want = point_source_radiance(field, tau, gamma)[0];
+                const double err = std::abs(std::exp(log_l) / want - 1.0);
+                if (g_print && err > 0.01) std::printf("  interp tau %g deg %g: %.4f\n", tau, deg, err);
+                worst = std::max(worst, err);
+                sum += err;
+                ++count;
+            }
+        if (g_print) std::printf("table interpolation g %.2f: mean %.4f worst %.4f\n", g, sum / count, worst);
+        CHECK_MSG(worst < 0.05 && sum / count < 0.01, std::to_string(worst));
+    }
+}
+
+void print_build_times() {
+    for (double g : {0.0, 0.5, 0.9, 0.95})
+        for (double a : {0.5, 0.9, 0.99}) {
+            const auto t0 = std::chrono::steady_clock::now();
+            const Table2D t = build_lamp_ms_table(hg(g), {a, a, a});
+            const double seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+            std::printf("build g %.2f albedo %.2f: %.2f s (%dx%d)\n", g, a, seconds, t.width, t.height);
+        }
+}
+
+}  // namespace
+
+int main(int argc, char** argv) {
+    g_print = argc > 1 && std::strcmp(argv[1], "--analysis") == 0;
+    check_azimuthal_phase();
+    check_energy();
+    check_threads_do_not_matter();
+    check_table_interpolation();
+    if (g_print) {
+        check_seed_noise();
+        if (argc > 2) print_build_times();
+    }
+    return airlight_test::test_result("test_point_source");
+}
