@@ -13,7 +13,7 @@ vec3 sky_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
 // a shadow ray, or the map of effects/sun_shadow_map); with multiple
 // scattering, its forward-scattered residual beam E_res too, which travels
 // nearly along the sun and is shadowed with it
-// (effects/multiple_scattering/physics.md section 10).
+// (effects/multiple_scattering/physics.md section 9).
 vec3 sun_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     float cos_n = dot(n, vec3(frame.sky.sun_direction));
     if (!HAS_SUN || cos_n <= 0.0f) return vec3(0.0f);

@@ -1,5 +1,5 @@
 // The point lamps' multiple scattering: its switch and table
-// (effects/multiple_scattering/physics.md section 14).
+// (effects/multiple_scattering/physics.md section 12).
 #include "lamp_ms_frame.hpp"
 
 #include <algorithm>
@@ -11,7 +11,7 @@ namespace airlight {
 
 // Below this sigma_s D (D the farthest lamp's distance from the camera) the
 // light scattered twice or more is under about 1e-3 of the single scattering
-// at every angle (section 14): no table.
+// at every angle (section 12): no table.
 constexpr float kNegligibleScatteringDepth = 1.0e-4f;
 
 bool lamp_ms_matters(const Scene& scene, const FrameData& data) {

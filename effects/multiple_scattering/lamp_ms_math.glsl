@@ -4,11 +4,11 @@
 // channel (RGB), L the radiance of the light scattered at least twice seen from
 // optical distance tau from a lamp of unit intensity in a medium of unit
 // extinction, at angle gamma from the lamp's direction
-// (effects/multiple_scattering/physics.md section 13).
+// (effects/multiple_scattering/physics.md section 11).
 CONST int LAMP_MS_NX = 160;  // optical distance: X = w(tau) / w(TAU_MAX), w = log(tau / TAU_MIN) + tau / TAU_LIN
 CONST int LAMP_MS_NY = 80;   // angle: Y = log(1 + gamma / GAMMA0) / log(1 + pi / GAMMA0)
 CONST float LAMP_MS_TAU_MIN = 1.0e-3f;  // below: L held (it grows only as log(1 / tau))
-CONST float LAMP_MS_TAU_MAX = 64.0f;    // beyond: no multiple scattering (section 14)
+CONST float LAMP_MS_TAU_MAX = 64.0f;    // beyond: no multiple scattering (section 12)
 CONST float LAMP_MS_TAU_LIN = 4.0f;     // logarithmic in tau below, linear above (L ~ e^{-tau / L_d} there)
 CONST float LAMP_MS_GAMMA0 = 0.02f;     // radians: rows fine near the lamp's direction
 CONST float LAMP_MS_GAMMA_MIN = 1.0e-4f;  // the first row is built at this angle (L diverges as log 1 / gamma)

@@ -1,9 +1,9 @@
 // The point lamps' multiple scattering in the homogeneous medium
-// (effects/multiple_scattering/physics.md sections 12 to 14), added to their
+// (effects/multiple_scattering/physics.md sections 10 to 12), added to their
 // exact single scattering (effects/lamp_airlight/lamp_terms.glsl): hook view_glow.
 
 // One channel of the field: exp(log_scale) L(tau, gamma) with the table's log L
-// (lamp_ms_math.glsl); no light at or beyond LAMP_MS_TAU_MAX (section 14).
+// (lamp_ms_math.glsl); no light at or beyond LAMP_MS_TAU_MAX (section 12).
 float lamp_ms_channel(int channel, float log_scale, float tau, float y) {
     if (tau >= LAMP_MS_TAU_MAX) return 0.0f;
     vec4 t = table_bilinear4(TABLE_LAMP_MS_GLOW, LAMP_MS_NX, LAMP_MS_NY, lamp_ms_x(tau), y);
@@ -13,7 +13,7 @@ float lamp_ms_channel(int channel, float log_scale, float tau, float y) {
 
 // The radiance of lamp `light`'s light scattered at least twice arriving at
 // point q from direction dir (looking along dir), times exp(-sigma_t t):
-// I sigma_t^2 e^{-sigma_t t} L(sigma_t R, gamma) per channel (section 13), R the
+// I sigma_t^2 e^{-sigma_t t} L(sigma_t R, gamma) per channel (section 11), R the
 // distance from q to the lamp, gamma the angle between dir and the lamp's direction.
 vec3 lamp_ms_field(PointLightGpu light, vec3 q, vec3 dir, float t) {
     vec3 v = vec3(light.position_radius) - q;
@@ -39,7 +39,7 @@ vec3 lamp_ms_field(PointLightGpu light, vec3 q, vec3 dir, float t) {
 
 // Hook view_glow: every lamp's multiply scattered light over [0, t_hit]: the
 // field at the camera less the field beyond the hit point seen through the
-// segment (section 13; surfaces neither block nor reflect the diffuse light).
+// segment (section 11; surfaces neither block nor reflect the diffuse light).
 vec3 lamp_ms_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!LAMP_MULTIPLE_SCATTERING) return radiance;
     vec3 sum = vec3(0.0f);

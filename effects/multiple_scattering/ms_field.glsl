@@ -1,5 +1,5 @@
 // The daytime atmosphere's multiply scattered light (effects/multiple_scattering/physics.md
-// section 10), read from the table TABLE_MS_FIELD (ms_layout.glsl) that the
+// section 9), read from the table TABLE_MS_FIELD (ms_layout.glsl) that the
 // plane-parallel solution fills: per species the phased diffuse radiance
 // K_i(y, d), the diffuse irradiance E(y, n) on surfaces and the sun's residual
 // forward beam E_res(y). Linear in altitude between the solver's levels,

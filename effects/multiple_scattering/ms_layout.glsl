@@ -1,5 +1,5 @@
 // The multiple-scattering field's frame data and constants (EFFECT_GLSL_LAYOUT;
-// effects/multiple_scattering/physics.md section 10). 4-byte scalars in groups
+// effects/multiple_scattering/physics.md section 9). 4-byte scalars in groups
 // of four and vec4, so std140 and C++ agree.
 
 // The table TABLE_MS_FIELD (ms_tables.cpp builds it from the plane-parallel

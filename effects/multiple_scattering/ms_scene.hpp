@@ -1,6 +1,6 @@
 // The multiple-scattering effect's quality setting (a base of Quality; the
 // key "multiple_scattering" of the scene format's "quality" object, parsed
-// by ms_keys.cpp; effects/multiple_scattering/physics.md section 10).
+// by ms_keys.cpp; effects/multiple_scattering/physics.md section 9).
 #pragma once
 
 namespace airlight {

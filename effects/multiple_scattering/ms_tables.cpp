@@ -1,5 +1,5 @@
 // The multiple-scattering field as the shading pass reads it
-// (effects/multiple_scattering/physics.md section 10; ms_layout.glsl): the
+// (effects/multiple_scattering/physics.md section 9; ms_layout.glsl): the
 // plane-parallel solution of the scene's atmosphere, sky, sun and ground,
 // solved once per weather state and tabulated over the solver's levels.
 #include "ms_tables.hpp"
@@ -49,7 +49,7 @@ RgbD ground_albedo(const Scene& scene) {
 }
 
 // C_m(mu_n, mu) = int_0^{2 pi} cos(m psi) max(mu_n mu + s_n s cos psi, 0) dpsi
-// in closed form (effects/multiple_scattering/physics.md section 10): the
+// in closed form (effects/multiple_scattering/physics.md section 9): the
 // azimuthal weight of Fourier mode m of the radiance at cosine mu in the
 // irradiance of a surface whose normal has cosine mu_n.
 double clamped_cosine_mode(int m, double mu_n, double mu) {
@@ -208,7 +208,7 @@ std::shared_ptr<const Table2D> multiple_scattering_table(const shader::SkyGpu& s
 namespace {
 
 // The ground's reflection alone (effects/multiple_scattering/physics.md
-// section 10): in an atmosphere too thin to scatter, the diffuse light is the
+// section 9): in an atmosphere too thin to scatter, the diffuse light is the
 // ground's Lambertian radiance rho E_0 / pi from below the horizon, so a
 // surface of normal n receives rho E_0 (1 - n_y) / 2, E_0 the sun's and the
 // sky's unscattered irradiance on the ground (through the column C(0)).

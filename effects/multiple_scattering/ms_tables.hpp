@@ -1,5 +1,5 @@
 // The daytime multiple-scattering field as the renderer uses it (issue 18;
-// effects/multiple_scattering/physics.md section 10): the plane-parallel
+// effects/multiple_scattering/physics.md section 9): the plane-parallel
 // solution (plane_parallel.hpp) of the scene's atmosphere under its sky and
 // sun over its ground, tabulated for the shading pass (ms_layout.glsl).
 #pragma once

@@ -1,5 +1,5 @@
 // The multiple-scattering effect's term of the shading pass (effect.cmake
-// EFFECT_HOOKS; effects/multiple_scattering/physics.md section 10).
+// EFFECT_HOOKS; effects/multiple_scattering/physics.md section 9).
 
 // Hook surface_irradiance: the diffuse light of the daytime atmosphere (light
 // scattered at least once, and the ground's reflection) on a surface point;

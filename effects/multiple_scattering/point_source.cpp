@@ -1,5 +1,5 @@
 // Multiple scattering of a point lamp in an infinite homogeneous medium
-// (effects/multiple_scattering/physics.md sections 12 to 14; measurements:
+// (effects/multiple_scattering/physics.md sections 10 to 12; measurements:
 // effects/multiple_scattering/docs/lamps.md).
 #include "point_source.hpp"
 
@@ -92,7 +92,7 @@ Vec scatter(const Vec& d, double mu, double phi) {
 // is 0.1 to 0.2 e-folds); theta by x = sqrt(theta / pi), fine towards the radial direction.
 constexpr int kBinsPerDecade = 12;
 constexpr int kThetaBins = 128;
-constexpr double kCoreRadius = 0.02;   // optical: the pooled core, J = f / R (section 13)
+constexpr double kCoreRadius = 0.02;   // optical: the pooled core, J = f / R (section 11)
 constexpr double kSwitchRadius = 1.0;  // log bins below, linear above
 constexpr double kLinearBin = 0.2;
 constexpr double kWeightFloor = 1.0e-3;
@@ -106,7 +106,7 @@ int theta_bin(double cos_theta, int nt) {
 }
 
 // The bin-averaged azimuthal phase P[k][j] (incoming bin k, outgoing bin j),
-// rows normalised so that sum_j P[k][j] Omega_j = 1 (section 13).
+// rows normalised so that sum_j P[k][j] Omega_j = 1 (section 11).
 std::vector<double> phase_matrix(const PointSourcePhase& phase, int nt) {
     std::vector<double> cos_at(size_t(nt) * 8), weight_at(size_t(nt) * 8), omega(static_cast<size_t>(nt));
     for (int k = 0; k < nt; ++k) {
@@ -191,7 +191,7 @@ double azimuthal_phase(const PointSourcePhase& phase, double cos_i, double cos_o
             continue;
         }
         // (1 / 2 pi) int (1 - g^2) / (4 pi) (A - B cos phi)^{-3/2} dphi
-        //   = (1 - g^2) / (4 pi) (2 / pi) E(m) / ((A - B) sqrt(A + B)),  m = 2B / (A + B) (section 13).
+        //   = (1 - g^2) / (4 pi) (2 / pi) E(m) / ((A - B) sqrt(A + B)),  m = 2B / (A + B) (section 11).
         const double A = 1.0 + g * g - 2.0 * g * a, B = 2.0 * std::abs(g) * b;
         const double m = std::clamp(2.0 * B / (A + B), 0.0, 1.0);
         const double e = std::comp_ellint_2(std::sqrt(m));
@@ -206,7 +206,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
     PointSourceField f;
     const int nt = kThetaBins;
     const double a_max = std::max({albedo[0], albedo[1], albedo[2]});
-    // The diffusion length of the most scattering channel (section 14): the
+    // The diffusion length of the most scattering channel (section 12): the
     // light beyond 25 of them is below e^{-25} of the lamp's; capped at 80.
     const double g_mean = phase.mean_cosine();
     const double absorb = std::max(3.0 * (1.0 - a_max) * (1.0 - a_max * g_mean), 0.0);
@@ -244,7 +244,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
                 ++count;
                 if (scattered) {
                     // A collision of light already scattered: its in-scattering
-                    // is of order >= 2 (section 13): score albedo x weight.
+                    // is of order >= 2 (section 11): score albedo x weight.
                     const double r = std::sqrt(r2);
                     const double mu = (dir.x * pos.x + dir.y * pos.y + dir.z * pos.z) / r;
                     const int ir = r2 < r_core2 ? nr : std::min(int(f.bin_coordinate(r)), nr - 1);
@@ -281,7 +281,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
         }
     }
 
-    // J = (4 pi / (N V)) sum_k H_k P_kj (section 13); the core: f = R J.
+    // J = (4 pi / (N V)) sum_k H_k P_kj (section 11); the core: f = R J.
     const std::vector<double> pm = phase_matrix(phase, nt);
     const double per_photon = 4.0 * kPi / double(f.photons);
     for (int c = 0; c < 3; ++c) {
@@ -342,7 +342,7 @@ double PointSourceField::at(int c, double r, double cos_theta) const {
     const double* l1 = l0 + nt;
     const double m = std::min({l0[j0], l0[j0 + 1], l1[j0], l1[j0 + 1]});
     if (m > -std::numeric_limits<double>::infinity()) {
-        // Geometric interpolation: J is close to exponential in R and in theta (section 13).
+        // Geometric interpolation: J is close to exponential in R and in theta (section 11).
         const double lo = l0[j0] * (1.0 - wt) + l0[j0 + 1] * wt, hi = l1[j0] * (1.0 - wt) + l1[j0 + 1] * wt;
         return std::exp(lo * (1.0 - ar) + hi * ar);
     }
@@ -353,7 +353,7 @@ double PointSourceField::at(int c, double r, double cos_theta) const {
 
 std::array<double, 3> point_source_radiance(const PointSourceField& field, double tau, double gamma) {
     // The view ray from the point at tau: s = b + h sinh u, R = h cosh u,
-    // cos theta = -tanh u (section 13); midpoint rule in u, steps du <= 0.04
+    // cos theta = -tanh u (section 11); midpoint rule in u, steps du <= 0.04
     // (theta and log R change by less) and ds <= 0.15 (e^{-s} by 15 %: 0.1 % error).
     const double b = tau * std::cos(gamma), h = std::max(tau * std::sin(gamma), tau * 1e-9);
     const double s_end = std::max(b, 0.0) + 60.0;

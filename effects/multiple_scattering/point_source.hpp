@@ -1,5 +1,5 @@
 // Multiple scattering of an isotropic point lamp in an infinite homogeneous
-// medium (effects/multiple_scattering/physics.md sections 12 to 14): the
+// medium (effects/multiple_scattering/physics.md sections 10 to 12): the
 // radiance field of the light scattered at least twice, built by a seeded
 // Monte Carlo of the in-scattering source and a line integral per table entry,
 // and the table the shading pass reads (effects/multiple_scattering/lamp_ms_math.glsl).
@@ -38,11 +38,11 @@ struct PointSourceSettings {
     int threads = 0;
 };
 
-// The in-scattering source of order >= 2, J(R, theta) (section 13), in optical
+// The in-scattering source of order >= 2, J(R, theta) (section 11), in optical
 // units (sigma_t = 1) for a lamp of unit intensity, per albedo channel: bins
 // over log R (R_core to R_switch), then R (to R_kill) and x = sqrt(theta / pi), theta the angle
 // between the light's propagation direction and the outward radial. Inside
-// R_core J = f(theta) / R (section 13).
+// R_core J = f(theta) / R (section 11).
 struct PointSourceField {
     int nr = 0;
     int nt = 0;
@@ -70,7 +70,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
 
 // The multiply scattered radiance (optical units, unit intensity) seen from a
 // point at optical distance tau from the lamp, looking at angle gamma from
-// the direction to the lamp: L = int_0^inf e^{-s} J(R(s), theta(s)) ds (section 13),
+// the direction to the lamp: L = int_0^inf e^{-s} J(R(s), theta(s)) ds (section 11),
 // per channel.
 std::array<double, 3> point_source_radiance(const PointSourceField& field, double tau, double gamma);
 
@@ -83,7 +83,7 @@ Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<doub
 std::shared_ptr<const Table2D> lamp_ms_table(const PointSourcePhase& phase, const std::array<double, 3>& albedo);
 
 // The azimuthal mean of the phase function, (1 / 2 pi) int p(cos theta_i cos theta_o +
-// sin theta_i sin theta_o cos phi) dphi (section 13; HG through the complete elliptic integral).
+// sin theta_i sin theta_o cos phi) dphi (section 11; HG through the complete elliptic integral).
 double azimuthal_phase(const PointSourcePhase& phase, double cos_i, double cos_o);
 
 }  // namespace airlight

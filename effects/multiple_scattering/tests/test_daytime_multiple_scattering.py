@@ -1,5 +1,5 @@
 """The renderer's daytime multiple scattering (issue 18; effects/multiple_scattering/physics.md
-section 10; effects/multiple_scattering/docs/renderer.md): the views of the stored Mitsuba
+section 9; effects/multiple_scattering/docs/renderer.md): the views of the stored Mitsuba
 reference (24 weathers and suns, 14 views, 3 channels) within max(3 %, 3 path-tracer standard
 errors) on 96 % of the values (the issue asks 99 %; renderer.md says where the rest are);
 ``quality.multiple_scattering`` false is single scattering exactly; an atmosphere that does not

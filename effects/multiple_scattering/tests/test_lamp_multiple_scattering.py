@@ -1,5 +1,5 @@
 """Multiple scattering of point lamps in the homogeneous fog (issue 18, night;
-effects/multiple_scattering/physics.md sections 12 to 14, effects/multiple_scattering/docs/lamps.md):
+effects/multiple_scattering/physics.md sections 10 to 12, effects/multiple_scattering/docs/lamps.md):
 the renderer's glow (its exact single scattering plus the table of light scattered twice or more)
 against the stored Mitsuba 3 path-traced glows
 (effects/multiple_scattering/tests/data/night_reference.json), the quality switch, the cases that
@@ -137,7 +137,7 @@ def test_no_table_where_multiple_scattering_does_not_matter(cpu, medium):
 
 def test_surface_ends_the_multiply_scattered_glow(cpu):
     """A wall behind the lamp cuts the view ray: the glow in front of it is below the unobstructed one and
-    tends to it as the wall recedes (the diffuse field beyond the wall subtracted, physics.md section 13)."""
+    tends to it as the wall recedes (the diffuse field beyond the wall subtracted, physics.md section 11)."""
     case = NIGHT["night_tau0.5_g0"]
     scene = ms_cases.view_scene(case, 9)  # 30 degrees from the lamp
     free = float(cpu.render(with_ms(scene, True))[0, 0, 1])

@@ -1,5 +1,5 @@
 // The point lamp's multiple-scattering builder (effects/multiple_scattering/point_source.cpp,
-// physics.md sections 12 to 14): the azimuthal phase mean against brute-force
+// physics.md sections 10 to 12): the azimuthal phase mean against brute-force
 // quadrature and its normalisation, energy conservation of the Monte Carlo
 // source (every order >= 2 scattering of an infinite medium: 4 pi a^2 / (1 - a)),
 // results independent of the thread count, the seed noise of the table, and
