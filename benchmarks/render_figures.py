@@ -87,6 +87,14 @@ def day_weather_strip(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(out)
 
 
+def night_street_figures(backend: str) -> None:
+    """The foggy street in isotropic and in forward-scattering fog, and as the eye sees it."""
+    demo("foggy_street", IMAGES / "foggy_street.png", backend, "--exposure", "0.1", "--tonemap", "linear")
+    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", backend, "--exposure", "0.03", "--tonemap", "linear")
+    demo("foggy_street", IMAGES / "foggy_street_eye.png", backend, "--exposure", "auto", "--tonemap", "loglog",
+         "--glare", "--pupil", "4", "--eyelashes")
+
+
 def heavy_rain_before_after(backend: str, out: Path) -> None:
     """day_heavy_rain without and with multiple scattering at the same fixed exposure."""
     tiles = []
@@ -124,9 +132,12 @@ def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
-    ap.add_argument("--only", choices=["rainbows", "daytime"], help="render only these figures")
+    ap.add_argument("--only", choices=["rainbows", "daytime", "night"], help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
+    if args.only == "night":
+        night_street_figures(args.backend)
+        return
     if args.only == "daytime":
         day_weather_strip(args.backend, IMAGES / "day_weather.png")
         heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
@@ -134,12 +145,7 @@ def main() -> None:
     rainbow_figures(args.backend, IMAGES / "rainbows.png", IMAGES / "rain_ends.png")
     if args.only == "rainbows":
         return
-    demo("foggy_street", IMAGES / "foggy_street.png", args.backend, "--exposure", "0.1",
-         "--tonemap", "linear")
-    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", args.backend, "--exposure", "0.03",
-         "--tonemap", "linear")
-    demo("foggy_street", IMAGES / "foggy_street_eye.png", args.backend, "--exposure", "auto", "--tonemap",
-         "loglog", "--glare", "--pupil", "4", "--eyelashes")
+    night_street_figures(args.backend)
     approaching_car_strip(args.backend, IMAGES / "approaching_car.png")
     day_weather_strip(args.backend, IMAGES / "day_weather.png")
     heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
