@@ -89,8 +89,9 @@ def day_weather_strip(backend: str, out: Path) -> None:
 
 def night_street_figures(backend: str) -> None:
     """The foggy street in isotropic and in forward-scattering fog, and as the eye sees it."""
-    demo("foggy_street", IMAGES / "foggy_street.png", backend, "--exposure", "0.1", "--tonemap", "linear")
-    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", backend, "--exposure", "0.03", "--tonemap", "linear")
+    linear = ("--tonemap", "linear")
+    demo("foggy_street", IMAGES / "foggy_street.png", backend, "--exposure", "0.1", *linear)
+    demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", backend, "--exposure", "0.03", *linear)
     demo("foggy_street", IMAGES / "foggy_street_eye.png", backend, "--exposure", "auto", "--tonemap", "loglog",
          "--glare", "--pupil", "4", "--eyelashes")
 
