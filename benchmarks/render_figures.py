@@ -92,8 +92,8 @@ def night_street_figures(backend: str) -> None:
     linear = ("--tonemap", "linear")
     demo("foggy_street", IMAGES / "foggy_street.png", backend, "--exposure", "0.1", *linear)
     demo("foggy_street_hg", IMAGES / "foggy_street_hg.png", backend, "--exposure", "0.03", *linear)
-    demo("foggy_street", IMAGES / "foggy_street_eye.png", backend, "--exposure", "auto", "--tonemap", "loglog",
-         "--glare", "--pupil", "4", "--eyelashes")
+    demo("foggy_street", IMAGES / "foggy_street_eye.png", backend, "--exposure", "auto", "--tonemap",
+         "loglog", "--glare", "--pupil", "4", "--eyelashes")
 
 
 def heavy_rain_before_after(backend: str, out: Path) -> None:
