@@ -24,8 +24,9 @@ for _dir in TEST_DIRS:
 BACKENDS = ("cpu", "gl")
 
 # Issue 18 turned multiple scattering on by default (quality.multiple_scattering). The tests written
-# before it check the single-scattering renderer against single-scattering references, so a scene dict
-# rendered outside effects/multiple_scattering/ renders with it off unless the scene sets it.
+# before it check the single-scattering renderer against single-scattering references, so a scene with
+# point lamps in a medium rendered outside effects/multiple_scattering/ renders with it off unless the
+# scene sets it.
 MULTIPLE_SCATTERING_TESTS = ROOT / "effects" / "multiple_scattering"
 
 
@@ -38,6 +39,11 @@ def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: 
     original = _rendering._with_film_size
 
     def off(scene: Any) -> Any:
+        lights = scene.get("lights")
+        lamps = isinstance(lights, list) and any(isinstance(x, dict) and x.get("type", "point") == "point"
+                                                 for x in lights)
+        if not (lamps and scene.get("medium")):  # only the lamps' term (the daytime tests set theirs)
+            return scene
         quality = scene.get("quality")
         if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
             scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
