@@ -12,11 +12,11 @@ float lamp_ms_channel(int channel, float log_scale, float tau, float y) {
 }
 
 // The radiance of lamp `light`'s light scattered at least twice arriving at
-// point q from direction dir (looking along dir), times exp(-sigma_t t):
-// I sigma_t^2 e^{-sigma_t t} L(sigma_t R, gamma) per channel (section 11), R the
-// distance from q to the lamp, gamma the angle between dir and the lamp's direction.
-vec3 lamp_ms_field(PointLightGpu light, vec3 q, vec3 dir, float t) {
-    vec3 v = vec3(light.position_radius) - q;
+// a point q from direction dir (looking along dir), times exp(-sigma_t t):
+// I sigma_t^2 e^{-sigma_t t} L(sigma_t R, gamma) per channel (section 11); v is
+// the vector from q to the lamp (relative, so that far from the origin it
+// keeps its precision), R its length, gamma its angle from dir.
+vec3 lamp_ms_field(PointLightGpu light, vec3 v, vec3 dir, float t) {
     float dist = length(v);
     float gamma = atan(length(cross(dir, v)), dot(dir, v));
     float y = lamp_ms_y(gamma);
@@ -45,8 +45,18 @@ vec3 lamp_ms_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     vec3 sum = vec3(0.0f);
     for (int i = 0; i < point_light_count(); ++i) {
         PointLightGpu light = point_light(i);
-        vec3 glow = lamp_ms_field(light, origin, dir, 0.0f);
-        if (t_hit < NO_HIT) glow -= lamp_ms_field(light, origin + t_hit * dir, dir, t_hit);
+        vec3 v = vec3(light.position_radius) - origin;
+        // A camera inside the lamp's sphere sees the fog from where the ray
+        // leaves the sphere, as for the single scattering (lamp_terms.glsl).
+        float radius = light.position_radius.w;
+        float x0 = 0.0f;
+        if (dot(v, v) < radius * radius) {
+            float b = dot(v, dir);
+            x0 = b + sqrt(max(radius * radius - (dot(v, v) - b * b), 0.0f));
+        }
+        if (x0 >= t_hit) continue;
+        vec3 glow = lamp_ms_field(light, v - x0 * dir, dir, x0);
+        if (t_hit < NO_HIT) glow -= lamp_ms_field(light, v - t_hit * dir, dir, t_hit);
         sum += max(glow, vec3(0.0f));
     }
     return radiance + sum;

@@ -217,3 +217,21 @@ def test_grey_and_per_channel_lookups_agree(cpu):
     sigma = scene["medium"]["sigma_t"]
     scene["medium"]["sigma_t"] = [sigma, sigma, sigma * (1.0 + 1e-6)]
     assert float(cpu.render(scene)[0, 0, 0]) == pytest.approx(grey, rel=1e-5)
+
+
+def test_a_camera_inside_a_lamp_far_from_the_origin_sees_the_same_glow_on_gl_and_cpu(renderer_cache):
+    """The fuzz harness's finding: a camera 1e6 m from the origin, 1 mm from a lamp's centre (inside
+    its 5 cm sphere), in fog of sigma_t 1. The multiply scattered light starts where the ray leaves
+    the sphere, from the lamp-relative vector (float32 positions there are good to 0.1 m only):
+    GL and the CPU agree, and the glow is that of a camera at the sphere's surface."""
+    far = np.array([-470953.26253385935, 999085.089608897, -366792.7219067727])
+    near = list(far + [7.4e-4, -3.7e-4, 6.0e-4])
+    scene = {"film": {"width": 1, "height": 1},
+             "camera": {"position": list(far), "look_at": [0.0, 0.0, 0.0], "up": [0, 1, 0], "fov_y": 1.0},
+             "medium": {"sigma_t": 1.0},
+             "lights": [{"type": "point", "position": near, "intensity": 50.0},
+                        {"type": "point", "position": [-465179.2, 1020409.5, -569955.6], "intensity": 1000.0}]}
+    cpu = renderer_cache("cpu").render(scene)[0, 0, :3]
+    gl = renderer_cache("gl").render(scene)[0, 0, :3]
+    np.testing.assert_allclose(gl, cpu, rtol=1e-2)
+    assert np.all(np.isfinite(cpu)) and np.all(cpu > 0.0)
