@@ -230,7 +230,8 @@ def test_a_camera_inside_a_lamp_far_from_the_origin_sees_the_same_glow_on_gl_and
              "camera": {"position": list(far), "look_at": [0.0, 0.0, 0.0], "up": [0, 1, 0], "fov_y": 1.0},
              "medium": {"sigma_t": 1.0},
              "lights": [{"type": "point", "position": near, "intensity": 50.0},
-                        {"type": "point", "position": [-465179.2, 1020409.5, -569955.6], "intensity": 1000.0}]}
+                        {"type": "point", "position": [-465179.2, 1020409.5, -569955.6],
+                         "intensity": 1000.0}]}
     cpu = renderer_cache("cpu").render(scene)[0, 0, :3]
     gl = renderer_cache("gl").render(scene)[0, 0, :3]
     np.testing.assert_allclose(gl, cpu, rtol=1e-2)
