@@ -125,6 +125,31 @@ namespace {
 
 bool cancelled(const std::atomic<bool>* cancel) { return cancel != nullptr && cancel->load(std::memory_order_relaxed); }
 
+// Shades pixel (x, row) into out (index row * width + x): its radiance, and
+// its render outputs when the frame asks for them (out.outputs sized for them).
+void shade_pixel(shader::CpuShader& shader, int x, int row, Image& out) {
+    const size_t pixel = size_t(row) * size_t(out.width) + size_t(x);
+    const glm::vec3 radiance = shader.render_pixel(x, row);
+    out.rgb[3 * pixel + 0] = radiance.r;
+    out.rgb[3 * pixel + 1] = radiance.g;
+    out.rgb[3 * pixel + 2] = radiance.b;
+    if (!shader.RENDER_OUTPUTS) return;
+    float* dst = out.outputs.data() + pixel * size_t(shader::OUTPUT_FLOATS);
+    for (int k = 0; k < shader::OUTPUT_FLOATS; ++k) dst[k] = shader.pixel_output_value(k);
+}
+
+// Sizes out.outputs for the frame's render outputs (none when not asked for).
+void prepare_outputs(const FrameData& data, Image& out) {
+    if (!data.features.outputs) {
+        out.output_floats = 0;
+        out.outputs.clear();
+        return;
+    }
+    const size_t size = size_t(out.width) * size_t(out.height) * size_t(shader::OUTPUT_FLOATS);
+    if (out.output_floats != shader::OUTPUT_FLOATS || out.outputs.size() != size) out.outputs.assign(size, 0.0f);
+    out.output_floats = shader::OUTPUT_FLOATS;
+}
+
 }  // namespace
 
 void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>& pixels, Image& out,
@@ -132,6 +157,7 @@ void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>&
     const size_t width = size_t(data.frame.film_width);
     if (out.width != data.frame.film_width || out.height != data.frame.film_height)
         throw std::logic_error("airlight: render_pixels needs a frame of the film's size");
+    prepare_outputs(data, out);
     shader::CpuShader program(data);
     std::vector<Table2D> pass_tables;
     run_grid_passes(data, program, pass_tables, threads);
@@ -144,11 +170,7 @@ void CpuBackend::render_pixels(const FrameData& data, const std::vector<size_t>&
             shader::CpuShader local = program;
             const size_t end = std::min(pixels.size(), size_t(b + 1) * kBatch);
             for (size_t k = size_t(b) * kBatch; k < end; ++k) {
-                const size_t pixel = pixels[k];
-                const glm::vec3 radiance = local.render_pixel(int(pixel % width), int(pixel / width));
-                out.rgb[3 * pixel + 0] = radiance.r;
-                out.rgb[3 * pixel + 1] = radiance.g;
-                out.rgb[3 * pixel + 2] = radiance.b;
+                shade_pixel(local, int(pixels[k] % width), int(pixels[k] / width), out);
             }
         },
         threads);
@@ -161,6 +183,7 @@ void CpuBackend::render(const FrameData& data, Image& out, const std::atomic<boo
     out.width = width;
     out.height = height;
     out.rgb.assign(size_t(width) * size_t(height) * 3, 0.0f);
+    prepare_outputs(data, out);
 
     shader::CpuShader program(data);
     // The grid passes first (FrameData::grid_passes), each into a table the
@@ -171,14 +194,10 @@ void CpuBackend::render(const FrameData& data, Image& out, const std::atomic<boo
         height,
         [&](int row) {
             if (cancelled(cancel)) return;
-            shader::CpuShader local = program;  // the shared code's functions are non-const members
-            float* dst = out.rgb.data() + size_t(row) * size_t(width) * 3;
-            for (int x = 0; x < width; ++x) {
-                const glm::vec3 radiance = local.render_pixel(x, row);
-                dst[3 * x + 0] = radiance.r;
-                dst[3 * x + 1] = radiance.g;
-                dst[3 * x + 2] = radiance.b;
-            }
+            // A copy per task: the shared code's functions are non-const
+            // members, and the pixel's outputs (pixel_outputs) are a member.
+            shader::CpuShader local = program;
+            for (int x = 0; x < width; ++x) shade_pixel(local, x, row, out);
         },
         threads);
     if (cancelled(cancel)) throw RenderCancelled();

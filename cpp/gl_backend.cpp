@@ -191,6 +191,8 @@ struct GlBackend::State {
     GLuint vao = 0, fbo = 0, color = 0;
     GLuint frame_ubo = 0, light_ssbo = 0, surface_ssbo = 0, bvh_ssbo = 0, spot_ssbo = 0;
     size_t frame_capacity = 0, light_capacity = 0, surface_capacity = 0, bvh_capacity = 0, spot_capacity = 0;
+    GLuint outputs_ssbo = 0;  // a tile's render outputs (RENDER_OUTPUTS), made on first use
+    size_t outputs_capacity = 0;
     int fbo_width = 0, fbo_height = 0;
     std::map<const Table2D*, std::pair<long, GLuint>> table_textures;  // by address: (serial, texture)
 
@@ -359,6 +361,7 @@ GlBackend::~GlBackend() {
         GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo,
                             state_->spot_ssbo};
         glDeleteBuffers(5, buffers);
+        if (state_->outputs_ssbo != 0) glDeleteBuffers(1, &state_->outputs_ssbo);
     }
     if (!forked_after_egl) destroy_context(state_->egl);
 }
@@ -381,6 +384,7 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
 
     shader::FrameUniforms frame = data.frame;
     frame.loop_guard_iterations = kLoopGuardIterations;
+    frame.tile_width = tile_w;  // row length of a tile's render outputs (render.frag)
     upload(s.frame_ubo, GL_UNIFORM_BUFFER, &frame, sizeof(frame), s.frame_capacity);
     upload(s.light_ssbo, GL_SHADER_STORAGE_BUFFER, data.point_lights.data(),
            data.point_lights.size() * sizeof(shader::PointLightGpu), s.light_capacity);
@@ -416,6 +420,22 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
     out.height = height;
     out.rgb.resize(size_t(width) * size_t(height) * 3);
     if (cut_pixels != nullptr) cut_pixels->clear();
+    // The render outputs (shaders/outputs_layout.glsl), when asked for: the
+    // shading pass writes a tile's into a storage buffer, read back per tile.
+    const bool outputs = data.features.outputs;
+    const size_t floats = size_t(shader::OUTPUT_FLOATS);
+    std::vector<float> tile_outputs;
+    out.output_floats = outputs ? shader::OUTPUT_FLOATS : 0;
+    out.outputs.assign(outputs ? size_t(width) * size_t(height) * floats : 0, 0.0f);
+    if (outputs) {
+        tile_outputs.resize(size_t(tile_w) * size_t(tile_h) * floats);
+        if (s.outputs_ssbo == 0) glCreateBuffers(1, &s.outputs_ssbo);
+        if (s.outputs_capacity < tile_outputs.size() * sizeof(float)) {
+            s.outputs_capacity = tile_outputs.size() * sizeof(float);
+            glNamedBufferData(s.outputs_ssbo, GLsizeiptr(s.outputs_capacity), nullptr, GL_DYNAMIC_READ);
+        }
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_OUTPUTS, s.outputs_ssbo);
+    }
     // Each tile is read back as RGBA: alpha 0 marks a pixel whose loops the driver cut (render.frag).
     std::vector<float> rgba(size_t(tile_w) * size_t(tile_h) * 4);
     glPixelStorei(GL_PACK_ALIGNMENT, 4);
@@ -423,14 +443,25 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
         for (int x0 = 0; x0 < width; x0 += tile_w) {
             if (cancel != nullptr && cancel->load()) throw RenderCancelled();
             const int w = std::min(tile_w, width - x0), h = std::min(tile_h, height - y0);
-            if (x0 > 0 || y0 > 0) {
+            if (x0 > 0 || y0 > 0 || frame.tile_width != w) {
                 frame.tile_origin_x = x0;  // pixel offset of this tile (render.frag)
                 frame.tile_origin_y = y0;
+                frame.tile_width = w;  // row length of its outputs
                 glNamedBufferSubData(s.frame_ubo, 0, sizeof(frame), &frame);
             }
             glViewport(0, 0, w, h);
             glDrawArrays(GL_TRIANGLES, 0, 3);
             glReadPixels(0, 0, w, h, GL_RGBA, GL_FLOAT, rgba.data());
+            if (outputs) {
+                glMemoryBarrier(GL_BUFFER_UPDATE_BARRIER_BIT);
+                glGetNamedBufferSubData(s.outputs_ssbo, 0, GLsizeiptr(size_t(w) * size_t(h) * floats * sizeof(float)),
+                                        tile_outputs.data());
+                for (int y = 0; y < h; ++y) {
+                    const float* src = tile_outputs.data() + size_t(y) * size_t(w) * floats;
+                    std::copy(src, src + size_t(w) * floats,
+                              out.outputs.data() + (size_t(y0 + y) * size_t(width) + size_t(x0)) * floats);
+                }
+            }
             for (int y = 0; y < h; ++y) {
                 for (int x = 0; x < w; ++x) {
                     const float* src = rgba.data() + (size_t(y) * size_t(w) + size_t(x)) * 4;

@@ -103,7 +103,7 @@ nlohmann::json to_json(py::handle obj, const std::string& path, int depth = 0) {
 // (Renderer::render's cancel flag) and raises KeyboardInterrupt once the worker
 // has stopped. Python runs signal handlers only on its main thread, which is
 // why the render itself moves to a worker.
-airlight::Image render_interruptibly(airlight::Renderer& renderer, const Scene& scene) {
+airlight::Image render_interruptibly(airlight::Renderer& renderer, const Scene& scene, bool with_outputs = false) {
     std::atomic<bool> cancel{false};
     std::promise<airlight::Image> result;
     std::future<airlight::Image> done = result.get_future();
@@ -112,7 +112,7 @@ airlight::Image render_interruptibly(airlight::Renderer& renderer, const Scene& 
         py::gil_scoped_release release;
         std::thread worker([&] {
             try {
-                result.set_value(renderer.render(scene, &cancel));
+                result.set_value(renderer.render(scene, &cancel, with_outputs));
             } catch (...) {
                 result.set_exception(std::current_exception());
             }
@@ -629,8 +629,46 @@ PYBIND11_MODULE(_core, m) {
                                [](const airlight::Renderer& r) { return airlight::backend_name(r.backend()); })
         .def("set_cpu_threads", &airlight::Renderer::set_cpu_threads)
         .def_property_readonly("cpu_fallback_pixels", &airlight::Renderer::cpu_fallback_pixels)
-        .def("render", [](airlight::Renderer& r, py::handle scene_obj) {
+        .def("render",
+             [](airlight::Renderer& r, py::handle scene_obj) {
+                 const Scene scene = scene_from_python(scene_obj);
+                 return image_to_numpy(render_interruptibly(r, scene));
+             })
+        // The named render outputs (airlight.render_outputs: names checked by the
+        // caller), each a float32 array (height, width[, 3]), computed in one pass.
+        .def("render_outputs", [](airlight::Renderer& r, py::handle scene_obj, const std::vector<std::string>& names) {
             const Scene scene = scene_from_python(scene_obj);
-            return image_to_numpy(render_interruptibly(r, scene));
+            bool extra = false;
+            for (const std::string& name : names) extra = extra || name != "radiance";
+            const airlight::Image image = render_interruptibly(r, scene, extra);
+            py::dict result;
+            for (const std::string& name : names) {
+                int components = 3;
+                for (const airlight::RenderOutput& o : airlight::render_outputs())
+                    if (o.name == name) components = o.components;
+                std::vector<float> values;
+                try {
+                    values = airlight::output_values(image, name);
+                } catch (const std::invalid_argument& e) {
+                    throw py::value_error(std::string("outputs: ") + e.what());
+                }
+                py::array_t<float> a(components == 1 ? std::vector<py::ssize_t>{image.height, image.width}
+                                                     : std::vector<py::ssize_t>{image.height, image.width, 3});
+                std::copy(values.begin(), values.end(), a.mutable_data());
+                result[py::str(name)] = a;
+            }
+            return result;
         });
+    m.def("render_outputs", [] {
+        py::list list;
+        for (const airlight::RenderOutput& o : airlight::render_outputs()) {
+            py::dict d;
+            d["name"] = o.name;
+            d["components"] = o.components;
+            d["description"] = o.description;
+            d["layer"] = o.layer;
+            list.append(d);
+        }
+        return list;
+    });
 }

@@ -58,9 +58,10 @@ DisplayImage Renderer::display(const Image& linear, const DisplaySettings& setti
     return run_display_stage(linear, settings, fov_y_degrees, impl_->cpu.threads, impl_->gl.get());
 }
 
-Image Renderer::render(const Scene& scene, const std::atomic<bool>* cancel) {
+Image Renderer::render(const Scene& scene, const std::atomic<bool>* cancel, bool with_outputs) {
     std::lock_guard<std::mutex> lock(impl_->mutex);
-    const FrameData data = make_frame_data(scene);
+    FrameData data = make_frame_data(scene);
+    data.features.outputs = with_outputs;
     Image image;
     impl_->cpu_fallback_pixels = 0;
     if (impl_->gl) {

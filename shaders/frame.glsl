@@ -21,7 +21,7 @@ struct FrameUniforms {
     int tile_origin_y;
     int spot_light_count;     // spot_lights[0, n)
     int loop_guard_iterations;  // GL: iterations of render.frag's loop-limit guard (2); 0 on the CPU
-    int unused_int0;
+    int tile_width;           // GL: width of the tile being drawn (its render outputs' rows)
     int unused_int1;
     float cull_fraction;      // contributions provably below this fraction of the pixel are skipped
     float march_steps;        // brute-force ray marching (quality.airlight "march"): steps per ray

@@ -8,6 +8,7 @@ CONST int BINDING_POINT_LIGHTS = 1;  // storage blocks: PointLightGpu[], Surface
 CONST int BINDING_SURFACES = 2;
 CONST int BINDING_BVH_NODES = 3;
 CONST int BINDING_SPOT_LIGHTS = 4;
+CONST int BINDING_OUTPUTS = 5;       // storage block written by the shading pass: the render outputs (outputs_layout.glsl)
 
 // An isotropic point lamp (effects/lamp_airlight/physics.md): a sphere of radius r emitting
 // radiant intensity I (W/sr), hence radiance I / (pi r^2) on its disc.

@@ -13,6 +13,9 @@ layout(std430, binding = BINDING_SPOT_LIGHTS) readonly buffer SpotLightBlock { S
 int spot_light_count() { return frame.spot_light_count; }
 SpotLightGpu spot_light(int i) { return spot_lights[i]; }
 BvhNodeGpu bvh_node(int i) { return bvh_nodes[i]; }
+// The render outputs of the tile being drawn (RENDER_OUTPUTS): OUTPUT_FLOATS per
+// pixel, pixels in rows of the tile's width (render.frag).
+layout(std430, binding = BINDING_OUTPUTS) writeonly buffer OutputBlock { float tile_outputs[]; };
 
 // The tables of the shading pass (effects/lamp_airlight/airlight_tables.hpp), one sampler per slot of
 // the registry (TABLE_*, generated from the effects' EFFECT_TABLES), read

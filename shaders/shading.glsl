@@ -34,7 +34,13 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     // Everything behind the homogeneous medium reaches the camera attenuated;
     // then the effects' media along the ray (view_transfer: attenuation and
     // in-scattering; view_glow: the lamps' light scattered toward the camera).
-    radiance *= transmittance(t_hit);
+    // The render outputs (outputs.glsl): where the ray ends, and this light as
+    // the first layer, attenuated with it.
+    outputs_ray_end(dir, t_hit, hit_index >= 0 && !emitter ? normal : vec3(0.0f));
+    layer_add(LAYER_SURFACES, radiance);
+    vec3 through_medium = transmittance(t_hit);
+    outputs_attenuate(through_medium);
+    radiance *= through_medium;
     return hooks_view_segment(origin, dir, t_hit, radiance);
 }
 
@@ -50,8 +56,10 @@ CONST float RADIANCE_MAX = 3.40282347e38f;
 // comparison, so that a GPU which flushes subnormal inputs gives 0 as well.
 float flush_subnormal(float v) { return abs(v) < RADIANCE_MIN_NORMAL ? 0.0f : v; }
 
-// Linear radiance of pixel (x, row), row 0 on top: the per-pixel entry point.
+// Linear radiance of pixel (x, row), row 0 on top: the per-pixel entry point;
+// with RENDER_OUTPUTS, its render outputs in pixel_outputs (outputs.glsl).
 vec3 render_pixel(int x, int row) {
+    outputs_begin();
     vec3 radiance = ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
     radiance = hooks_pixel_cores(x, row, radiance);
     radiance = vec3(flush_subnormal(radiance.r), flush_subnormal(radiance.g), flush_subnormal(radiance.b));

@@ -36,12 +36,16 @@ vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance)
     if (!HAS_ATMOSPHERE) return radiance;
     vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
     vec3 inscatter;
+    vec3 rainbow;  // the rain's sunlight, kept apart only for the render outputs (rainbow_layer_apart)
     vec3 through_atmosphere;
     if (SKY_MARCH) {
-        atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter,
+        atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter, rainbow,
                                     through_atmosphere);
     } else {
-        atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, through_atmosphere);
+        atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, rainbow, through_atmosphere);
     }
-    return radiance * through_atmosphere + inscatter;
+    outputs_attenuate(through_atmosphere);
+    layer_add(LAYER_SKY, inscatter);
+    layer_add(LAYER_RAINBOW, rainbow);
+    return radiance * through_atmosphere + inscatter + rainbow;
 }

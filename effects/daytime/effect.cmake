@@ -23,6 +23,8 @@ set(EFFECT_HOOKS
     surface_irradiance=sun_surface_irradiance
     escaping_radiance=sky_escaping_radiance
     view_transfer=atmosphere_view_transfer)
+set(EFFECT_LAYERS
+    "sky=the sky dome's and the sun's light scattered toward the camera by the atmosphere (molecules, aerosol, rain: every order where multiple scattering is on), but for the rainbow's part")
 set(EFFECT_SCENE_HEADER daytime_scene.hpp)
 set(EFFECT_SCENE_MEMBERS "Sky sky" "Sun sun" "Atmosphere atmosphere")
 set(EFFECT_QUALITY DaytimeQuality)

@@ -193,18 +193,30 @@ SpeciesLight species_light(SkyTableDirection t, MsDirection ms_dir, float y, vec
     return out_light;
 }
 
+// True when the rain's once-scattered sunlight goes to the render outputs'
+// rainbow layer (shaders/outputs.glsl) instead of being summed with the rest.
+bool rainbow_layer_apart(int species) { return RENDER_OUTPUTS && HAS_RAINBOW && species == SPECIES_RAIN; }
+
 // Extinction (rgb) and in-scattering J (rgb, per unit length) at altitude y,
 // with each species' profile piece chosen at altitude y_piece (so that the
-// ends of a scattering volume use the volume's own pieces).
-void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigma_t, OUT(vec3) j) {
+// ends of a scattering volume use the volume's own pieces); j_rainbow: the
+// rain's sunlight, when kept apart (rainbow_layer_apart), else 0.
+void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigma_t, OUT(vec3) j,
+                      OUT(vec3) j_rainbow) {
     sigma_t = vec3(0.0f);
     j = vec3(0.0f);
+    j_rainbow = vec3(0.0f);
     for (int i = 0; i < 3; ++i) {
         if (!species_present(i)) continue;
         SpeciesGpu sp = frame.species[i];
         float rho = piece_density(sp, profile_piece(sp, y_piece), y);
         sigma_t += vec3(sp.sigma_t) * rho;
-        j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i] + light.ms[i]);
+        if (rainbow_layer_apart(i)) {
+            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.ms[i]);
+            j_rainbow = vec3(sp.sigma_s) * rho * light.sun[i];
+        } else {
+            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i] + light.ms[i]);
+        }
     }
 }
 
@@ -362,8 +374,10 @@ vec3 source_function(vec3 j, vec3 sigma) {
 
 // Light scattered into the ray o + s d over [0, s_end] by the atmosphere
 // (`inscatter`, already attenuated on its way to the camera, by the
-// homogeneous medium too) and the atmosphere's transmittance over the ray
-// (`transmittance`; the medium's is applied by the caller). Scattering
+// homogeneous medium too; the rain's once-scattered sunlight apart in
+// `rainbow` when the render outputs keep it apart, rainbow_layer_apart) and
+// the atmosphere's transmittance over the ray (`transmittance`; the medium's
+// is applied by the caller). Scattering
 // volumes (effects/daytime/physics.md, seed equations 3 to 6, corrected): the ray
 // is cut where it crosses the altitude levels (which include every profile
 // break), and in each volume each species' sky and sun shares of the source
@@ -372,8 +386,9 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // constant-source form is the case r = 0). sigma_medium: the
 // homogeneous medium's extinction, which attenuates but scatters no sky light.
 void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(vec3) inscatter,
-                           OUT(vec3) transmittance) {
+                           OUT(vec3) rainbow, OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
+    rainbow = vec3(0.0f);
     transmittance = vec3(1.0f);
     float s_in;
     float s_out;
@@ -427,8 +442,13 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
             inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sky[i], sigma_a),
                                                    source_function(scale_b * light_b.sky[i], sigma_b));
             if (HAS_SUN) {
-                inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sun[i], sigma_a),
-                                                       source_function(scale_b * light_b.sun[i], sigma_b));
+                vec3 sun_part = weight * source_integral3(dtau, source_function(scale_a * light_a.sun[i], sigma_a),
+                                                          source_function(scale_b * light_b.sun[i], sigma_b));
+                if (rainbow_layer_apart(i)) {
+                    rainbow += sun_part;
+                } else {
+                    inscatter += sun_part;
+                }
             }
             if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
                 inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.ms[i], sigma_a),
@@ -448,8 +468,9 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
 vec3 atmosphere_transmittance(vec3 o, vec3 d, float s_end) {
     if (!HAS_ATMOSPHERE) return vec3(1.0f);
     vec3 inscatter;
+    vec3 rainbow;
     vec3 t;
-    atmosphere_scattering(o, d, s_end, vec3(0.0f), inscatter, t);
+    atmosphere_scattering(o, d, s_end, vec3(0.0f), inscatter, rainbow, t);
     return t;
 }
 
@@ -482,8 +503,9 @@ float march_far_distance(vec3 o, vec3 d, float s_in, float s_out, vec3 sigma_med
 // equal length over [s_in, s_far] (march_far_distance: rays end where they
 // have become opaque); transmittance accumulated step by step.
 void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium, int steps,
-                                 OUT(vec3) inscatter, OUT(vec3) transmittance) {
+                                 OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
+    rainbow = vec3(0.0f);
     transmittance = vec3(1.0f);
     float s_in;
     float s_out;
@@ -502,9 +524,11 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
         float y = clamp(o.y + d.y * s, 0.0f, frame.atmosphere.top);
         vec3 sigma;
         vec3 j;
-        atmosphere_point(y, y, species_light(t, ms_dir, y, atmosphere_column(y), sun_phase), sigma, j);
-        inscatter += exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds)) *
-                     j * ds;
+        vec3 j_rainbow;
+        atmosphere_point(y, y, species_light(t, ms_dir, y, atmosphere_column(y), sun_phase), sigma, j, j_rainbow);
+        vec3 reaching = exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds));
+        inscatter += reaching * j * ds;
+        rainbow += reaching * j_rainbow * ds;
         tau += sigma * ds;
     }
     transmittance = exp(-tau);

@@ -18,3 +18,5 @@ set(EFFECT_HOOKS
     emitter_hit=point_lights_emitter_hit       # the lamps' spheres
     view_glow=point_lights_view_glow           # the airlight
     pixel_cores=point_lights_pixel_cores)      # lamps smaller than a pixel
+set(EFFECT_LAYERS
+    "lamps=the point lamps' light scattered toward the camera by the homogeneous medium (once, and more often where multiple scattering is on)")

@@ -93,7 +93,9 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
 vec3 point_lights_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_AIRLIGHT) return radiance;
     for (int i = 0; i < point_light_count(); ++i) {
-        radiance += point_light_airlight(point_light(i), origin, dir, t_hit, radiance);
+        vec3 airlight = point_light_airlight(point_light(i), origin, dir, t_hit, radiance);
+        layer_add(LAYER_LAMPS, airlight);
+        radiance += airlight;
     }
     return radiance;
 }
@@ -128,6 +130,8 @@ vec3 composite_lamp_core(vec3 radiance, vec3 rel, float r, float cover, vec3 cor
     vec3 n;
     if (HAS_SURFACES && trace_surfaces(origin, rel / d, hit, n) < d - r) return radiance;
     core *= transmittance(d) * atmosphere_transmittance(origin, rel / d, d);
+    outputs_cover(max(1.0f - cover, 0.0f));
+    layer_add(LAYER_SURFACES, core * cover);
     return radiance * max(1.0f - cover, 0.0f) + core * cover;
 }
 

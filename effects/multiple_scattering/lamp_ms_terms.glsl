@@ -59,5 +59,6 @@ vec3 lamp_ms_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
         if (t_hit < NO_HIT) glow -= lamp_ms_field(light, v - t_hit * dir, dir, t_hit);
         sum += max(glow, vec3(0.0f));
     }
+    layer_add(LAYER_LAMPS, sum);
     return radiance + sum;
 }

@@ -5,6 +5,8 @@ set(EFFECT_FEATURES
     rainbow=HAS_RAINBOW)  # rain lit by the sun scatters with the Mie table
 set(EFFECT_TABLES
     rainbow)  # RGBA phase against the scattering angle (one row)
+set(EFFECT_LAYERS
+    "rainbow=sunlight scattered once by the rain's drops through their Mie phase function toward the camera (the bows, Alexander's dark band, the drops' glow around the sun)")
 set(EFFECT_GLSL_MATH rainbow_math.glsl)
 set(EFFECT_GLSL_PIXEL rainbow.glsl)
 # Its switch depends on the daytime effect's sun (registered before it, since

@@ -17,6 +17,8 @@ set(EFFECT_HOOKS
     emitter_hit=spot_lights_emitter_hit
     view_glow=spot_lights_view_glow
     pixel_cores=spot_lights_pixel_cores)
+set(EFFECT_LAYERS
+    "spots=the spotlights' and headlights' light scattered toward the camera by the homogeneous medium")
 set(EFFECT_SCENE_HEADER spot_scene.hpp)
 set(EFFECT_QUALITY SpotQuality)
 set(EFFECT_QUALITY_KEYS spot_glow_samples)

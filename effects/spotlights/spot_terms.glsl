@@ -39,7 +39,11 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
 // Hook view_glow: the airlight of every spot over [0, t_hit].
 vec3 spot_lights_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_SPOT_AIRLIGHT) return radiance;
-    for (int i = 0; i < spot_light_count(); ++i) radiance += spot_light_airlight(i, dir, t_hit, radiance);
+    for (int i = 0; i < spot_light_count(); ++i) {
+        vec3 airlight = spot_light_airlight(i, dir, t_hit, radiance);
+        layer_add(LAYER_SPOTS, airlight);
+        radiance += airlight;
+    }
     return radiance;
 }
 

@@ -33,12 +33,36 @@ public:
 };
 
 // Linear radiance, W/(m^2 sr): `rgb` holds width * height RGB triples, row 0
-// is the top row of the image.
+// is the top row of the image. `outputs`: the render outputs beside the
+// radiance when the render asked for them (Renderer::render's with_outputs),
+// packed `output_floats` per pixel; read them with output_values. Empty otherwise.
 struct Image {
     int width = 0;
     int height = 0;
     std::vector<float> rgb;
+    int output_floats = 0;
+    std::vector<float> outputs;
 };
+
+// One of the outputs a render can give (README "Render outputs"): its name,
+// components per pixel (1 or 3) and what it holds, with its unit.
+struct RenderOutput {
+    std::string name;
+    int components = 3;
+    std::string description;
+    bool layer = false;  // one of the layers that sum to the radiance
+};
+
+// Every output, in a fixed order: radiance, depth, distance_z, normal,
+// transmittance, then the layers (the core's and each effect's EFFECT_LAYERS,
+// in registry order).
+const std::vector<RenderOutput>& render_outputs();
+
+// Output `name` of an image rendered with its outputs: width * height *
+// components floats, row 0 on top; depth and distance_z are +inf where the ray
+// escapes. "radiance" is the image's rgb. Throws std::invalid_argument for an
+// unknown name, or for any other name when the image has no outputs.
+std::vector<float> output_values(const Image& image, const std::string& name);
 
 // True when an OpenGL 4.5 core context can be created through EGL here; on
 // false, `reason` (if given) says why; on true, `gl_renderer` (if given) is the
@@ -81,7 +105,9 @@ public:
     Backend backend() const;
     // `cancel` (optional) is polled while rendering (per row on the CPU, per
     // tile on GL): once it is true, render throws RenderCancelled.
-    Image render(const Scene& scene, const std::atomic<bool>* cancel = nullptr);
+    // `with_outputs`: compute the render outputs (render_outputs()) in the same
+    // pass, into Image::outputs; without them the frame pays nothing for them.
+    Image render(const Scene& scene, const std::atomic<bool>* cancel = nullptr, bool with_outputs = false);
 
     // The display stage (include/airlight/display.hpp, display_image) on this
     // renderer's backend: the GL backend runs the glare convolution and the
