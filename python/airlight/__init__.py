@@ -41,6 +41,8 @@ from ._image_io import load_pfm, save_pfm, save_png
 from ._lights import headlights
 from ._rainbow import rainbow_phase
 from ._rendering import (
+    LAYERS,
+    OUTPUTS,
     BackendUnavailableError,
     Renderer,
     available_backends,
@@ -53,6 +55,8 @@ from ._scenes import SceneLike, load_scene, preset, preset_names
 from ._version import __version__ as __version__
 
 __all__ = [
+    "LAYERS",
+    "OUTPUTS",
     "TONEMAPS",
     "BackendUnavailableError",
     "GlareLike",

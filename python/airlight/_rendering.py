@@ -1,12 +1,14 @@
 """Rendering: backend discovery and selection (``"gl"``, ``"cpu"``, ``"auto"``;
 :func:`backend_info`), the :class:`Renderer` that keeps its backend's state across
-frames, one-frame :func:`render`, and :func:`table_stats` on the scattering tables
+frames, one-frame :func:`render`, the render outputs beside the radiance
+(:data:`OUTPUTS`, :data:`LAYERS`), and :func:`table_stats` on the scattering tables
 built."""
 
 from __future__ import annotations
 
 import warnings
-from typing import Any
+from collections.abc import Sequence
+from typing import Any, overload
 
 import numpy as np
 
@@ -23,6 +25,36 @@ BackendUnavailableError.__doc__ = (
 )
 
 _BACKENDS = ("auto", "gl", "cpu")
+
+#: The outputs a render can return (``render(scene, outputs=[...])``), name ->
+#: what it holds and its unit, in a fixed order: ``radiance``, ``depth``,
+#: ``distance_z``, ``normal``, ``transmittance``, then the layers (:data:`LAYERS`).
+OUTPUTS: dict[str, str] = {o["name"]: o["description"] for o in _core.render_outputs()}
+#: The outputs that are layers of the radiance: parts that sum to it (each
+#: effect declares its own), in the order of :data:`OUTPUTS`.
+LAYERS: tuple[str, ...] = tuple(o["name"] for o in _core.render_outputs() if o["layer"])
+
+
+def _output_names(outputs: object) -> list[str]:
+    """The output names asked for, checked, ``"layers"`` expanded to every layer,
+    each once in the order asked."""
+    if isinstance(outputs, (str, bytes)) or not isinstance(outputs, Sequence):
+        raise TypeError(f"outputs: expected a list of output names, got {type(outputs).__name__}")
+    if len(outputs) == 0:
+        raise ValueError("outputs: asks for no output (leave it out for the radiance alone)")
+    names: list[str] = []
+    for i, name in enumerate(outputs):
+        if not isinstance(name, str):
+            raise TypeError(f"outputs[{i}]: expected an output name (str), got {type(name).__name__}")
+        if name == "layers":
+            expanded = list(LAYERS)
+        elif name in OUTPUTS:
+            expanded = [name]
+        else:
+            raise ValueError(f"outputs[{i}]: unknown output {name!r}; one of {', '.join(OUTPUTS)}, "
+                             f"or 'layers' (all of {', '.join(LAYERS)})")
+        names += [n for n in expanded if n not in names]
+    return names
 _MAX_CPU_THREADS = 1024
 _warned_fallback = False
 
@@ -109,13 +141,30 @@ class Renderer:
             raise RuntimeError("Renderer is closed")
         return self._native
 
-    def render(self, scene: SceneLike, *, width: int | None = None,
-               height: int | None = None) -> np.ndarray:
+    @overload
+    def render(self, scene: SceneLike, *, width: int | None = ..., height: int | None = ...,
+               outputs: None = ...) -> np.ndarray: ...
+
+    @overload
+    def render(self, scene: SceneLike, *, width: int | None = ..., height: int | None = ...,
+               outputs: Sequence[str]) -> dict[str, np.ndarray]: ...
+
+    def render(self, scene: SceneLike, *, width: int | None = None, height: int | None = None,
+               outputs: Sequence[str] | None = None) -> np.ndarray | dict[str, np.ndarray]:
         """Linear radiance of ``scene``: float32 array (height, width, 3), row 0
         on top. ``width``/``height`` override the scene's film size; one of them alone
         keeps the film's aspect ratio (``render(scene, width=160)`` of a 320x240 film
-        is 160x120: the other side rounded to the nearest integer, at least 1)."""
-        return self._active().render(_with_film_size(scene, width, height))
+        is 160x120: the other side rounded to the nearest integer, at least 1).
+
+        ``outputs``: names from :data:`OUTPUTS` (``"layers"`` for every layer); the
+        result is then a dict of those names to float32 arrays, (height, width) for
+        ``depth`` and ``distance_z``, (height, width, 3) for the others, all computed
+        in the same pass. The layers (:data:`LAYERS`) sum to ``radiance``. A frame
+        that asks for the radiance alone computes none of the others."""
+        sized = _with_film_size(scene, width, height)
+        if outputs is None:
+            return self._active().render(sized)
+        return self._active().render_outputs(sized, _output_names(outputs))
 
     def close(self) -> None:
         """Releases the GL context and everything cached (idempotent)."""
@@ -128,11 +177,25 @@ class Renderer:
         self.close()
 
 
+@overload
+def render(scene: SceneLike, backend: str = ..., *, width: int | None = ..., height: int | None = ...,
+           outputs: None = ...) -> np.ndarray: ...
+
+
+@overload
+def render(scene: SceneLike, backend: str = ..., *, width: int | None = ..., height: int | None = ...,
+           outputs: Sequence[str]) -> dict[str, np.ndarray]: ...
+
+
 def render(scene: SceneLike, backend: str = "auto", *, width: int | None = None,
-           height: int | None = None) -> np.ndarray:
-    """Renders one frame; see :class:`Renderer` (which is faster for many frames)."""
+           height: int | None = None,
+           outputs: Sequence[str] | None = None) -> np.ndarray | dict[str, np.ndarray]:
+    """Renders one frame; see :meth:`Renderer.render` (``outputs``: the render outputs
+    beside the radiance) and :class:`Renderer` (which is faster for many frames)."""
     with Renderer(backend) as renderer:
-        return renderer.render(scene, width=width, height=height)
+        if outputs is None:
+            return renderer.render(scene, width=width, height=height)
+        return renderer.render(scene, width=width, height=height, outputs=outputs)
 
 
 def table_stats() -> dict[str, dict[str, Any]]:
