@@ -1,5 +1,5 @@
 // airlight-demo: renders a scene file headless to PNG (8-bit sRGB through the
-// display stage: exposure, glare, tone curve) or PFM (float radiance), or the
+// display stage: exposure, glare, tone curve), PFM or OpenEXR (float radiance), or the
 // approaching-car headlight sequence (issue 8). Bad input exits non-zero with
 // a one-line message.
 #include <unistd.h>
@@ -36,11 +36,12 @@ namespace {
 std::atomic<bool> interrupted{false};  // set by SIGINT (main); renders poll it
 
 const char* kUsage =
-    "usage: airlight-demo --scene S.json --out F.png|F.pfm [--backend auto|gl|cpu]\n"
+    "usage: airlight-demo --scene S.json --out F.png|F.pfm|F.exr [--backend auto|gl|cpu]\n"
     "                     [--width W] [--height H] (one alone: the scene's aspect ratio)\n"
+    "  F.pfm, F.exr: linear radiance (EXR: channels R, G, B, float32; --half: half floats)\n"
     "  an interactive window (GLFW and a display; --out optional: the last frame shown\n"
     "  is written there on closing):\n"
-    "                     --scene S.json --window [--out F.png|F.pfm]\n"
+    "                     --scene S.json --window [--out F.png|F.pfm|F.exr]\n"
     "  display stage (PNG; overrides the scene's \"display\" object):\n"
     "                     [--exposure E|auto] [--tonemap linear|loglog|reinhard|filmic]\n"
     "                     [--white W] [--glare | --no-glare] [--pupil MM|auto] [--eyelashes]\n"
@@ -56,6 +57,7 @@ struct Options {
     std::string scene, out, backend = "auto", sequence;
     int width = 0, height = 0;
     bool window = false;
+    bool half = false;  // --half: an EXR's channels as half floats
     // Display overrides (empty: the scene's).
     std::string exposure, tonemap, pupil;
     float white = 0.0f;
@@ -131,6 +133,10 @@ Options parse_args(int argc, char** argv) {
         }
         if (arg == "--glare" || arg == "--no-glare") {
             o.glare = arg == "--glare" ? 1 : 0;
+            continue;
+        }
+        if (arg == "--half") {
+            o.half = true;
             continue;
         }
         if (arg == "--eyelashes") {
@@ -331,9 +337,12 @@ int main(int argc, char** argv) {
     // Ctrl-C ends a long render between rows (or GL tiles) with a message.
     std::signal(SIGINT, [](int) { interrupted = true; });
     const Options o = parse_args(argc, argv);
-    if (o.sequence.empty() && !o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm")) {
-        fail("--out must end in .png or .pfm, got '" + o.out + "'");
+    if (o.sequence.empty() && !o.out.empty() && !ends_with(o.out, ".png") && !ends_with(o.out, ".pfm") &&
+        !ends_with(o.out, ".exr")) {
+        fail("--out must end in .png, .pfm or .exr, got '" + o.out + "'");
     }
+    if (o.half && (o.window || !o.sequence.empty() || !ends_with(o.out, ".exr")))
+        fail("--half needs --out F.exr (and neither --window nor --sequence)");
     if (o.sequence.empty() && !o.out.empty()) {
         // A bad destination is reported before rendering, not after.
         const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
@@ -388,6 +397,12 @@ int main(int argc, char** argv) {
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         if (ends_with(o.out, ".pfm")) {
             write_pfm(o.out, image);
+            print_report(o.out, image, backend, ms, nullptr);
+        } else if (ends_with(o.out, ".exr")) {
+            // The render's outputs as named images of one EXR file (`radiance`: the channels R, G, B);
+            // further outputs (depth, transmittance) are more entries of this list.
+            std::vector<NamedImage> outputs = {{"radiance", 3, image.rgb}};
+            write_exr(o.out, image.width, image.height, outputs, o.half);
             print_report(o.out, image, backend, ms, nullptr);
         } else {
             const DisplayImage shown = renderer.display(image, display_settings(scene, o), scene.camera.fov_y_degrees);

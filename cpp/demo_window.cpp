@@ -18,6 +18,7 @@
 
 #include <cmath>
 #include <cstdio>
+#include <cstring>
 #include <glm/glm.hpp>
 #include <stdexcept>
 #include <string>
@@ -173,10 +174,15 @@ int run_window(Scene scene, Backend backend, DisplaySettings display, const std:
     glfwDestroyWindow(window);
     glfwTerminate();
     if (!out.empty() && !image.rgb.empty()) {
-        // The last frame shown: the PNG as displayed, the PFM as its radiance.
-        const bool pfm = out.size() >= 4 && out.compare(out.size() - 4, 4, ".pfm") == 0;
-        if (pfm)
+        // The last frame shown: the PNG as displayed, the PFM and the EXR (float32) as its radiance.
+        const auto ends_with = [&](const char* suffix) {
+            const std::size_t n = std::strlen(suffix);
+            return out.size() >= n && out.compare(out.size() - n, n, suffix) == 0;
+        };
+        if (ends_with(".pfm"))
             write_pfm(out, image);
+        else if (ends_with(".exr"))
+            write_exr(out, image);
         else
             write_png(out, shown.width, shown.height, shown.srgb8);
         std::printf("airlight-demo: %s %dx%d (the last frame shown)\n", out.c_str(), image.width, image.height);

@@ -176,6 +176,40 @@ airlight::Image image_from_numpy(const py::array_t<float, py::array::c_style | p
     return image;
 }
 
+// A failed file operation (std::runtime_error: the path and the library's
+// reason) as Python's OSError; call with the GIL held.
+[[noreturn]] void throw_os_error(const std::runtime_error& e) {
+    PyErr_SetString(PyExc_OSError, e.what());
+    throw py::error_already_set();
+}
+
+using FloatArray = py::array_t<float, py::array::c_style | py::array::forcecast>;
+
+// EXR images from Python: (name, float32 array of shape (height, width) or
+// (height, width, 3)) pairs, all of one size (airlight._image_io checks the
+// arguments first and names them; these checks are the last line).
+std::vector<airlight::NamedImage> named_images_from_numpy(const std::vector<std::pair<std::string, FloatArray>>& images,
+                                                          int& width, int& height) {
+    std::vector<airlight::NamedImage> out;
+    for (std::size_t i = 0; i < images.size(); ++i) {
+        const auto& [name, a] = images[i];
+        const std::string field = "images['" + name + "']";
+        if (!(a.ndim() == 2 || (a.ndim() == 3 && a.shape(2) == 3)))
+            throw py::value_error(field + ": expected shape (height, width) or (height, width, 3)");
+        if (i == 0) {
+            if (a.shape(0) > std::numeric_limits<int>::max() || a.shape(1) > std::numeric_limits<int>::max())
+                throw py::value_error(field + ": too large");
+            height = int(a.shape(0));
+            width = int(a.shape(1));
+        } else if (a.shape(0) != height || a.shape(1) != width) {
+            throw py::value_error(field + ": expected height " + std::to_string(height) + " and width " +
+                                  std::to_string(width) + " as the first image's");
+        }
+        out.push_back({name, a.ndim() == 3 ? 3 : 1, std::vector<float>(a.data(), a.data() + a.size())});
+    }
+    return out;
+}
+
 // The multiple-scattering solver's result as numpy arrays
 // (effects/multiple_scattering/plane_parallel.hpp names the fields).
 py::dict field_to_python(const airlight::MultipleScatteringField& f) {
@@ -617,6 +651,44 @@ PYBIND11_MODULE(_core, m) {
           [](const std::string& path, const py::array_t<float, py::array::c_style | py::array::forcecast>& radiance) {
               airlight::write_pfm(path, image_from_numpy(radiance));
           });
+
+    m.def(
+        "write_exr",
+        [](const std::string& path, const std::vector<std::pair<std::string, FloatArray>>& images, bool half) {
+            int width = 0, height = 0;
+            const std::vector<airlight::NamedImage> named = named_images_from_numpy(images, width, height);
+            try {
+                py::gil_scoped_release release;
+                airlight::write_exr(path, width, height, named, half);
+            } catch (const std::runtime_error& e) {
+                throw_os_error(e);
+            }
+        },
+        py::arg("path"), py::arg("images"), py::arg("half") = false);
+    m.def(
+        "read_exr",
+        [](const std::string& path) {
+            int width = 0, height = 0;
+            std::vector<airlight::NamedImage> images;
+            try {
+                py::gil_scoped_release release;
+                images = airlight::read_exr(path, width, height);
+            } catch (const std::runtime_error& e) {
+                throw_os_error(e);
+            }
+            py::list out;
+            for (const airlight::NamedImage& im : images) {
+                std::vector<py::ssize_t> shape = {height, width};
+                if (im.components != 1) shape.push_back(im.components);
+                // A channel name is any bytes in a foreign file: undecodable ones replaced.
+                auto name = py::reinterpret_steal<py::str>(
+                    PyUnicode_DecodeUTF8(im.name.data(), py::ssize_t(im.name.size()), "replace"));
+                if (!name) throw py::error_already_set();
+                out.append(py::make_tuple(name, py::array_t<float>(shape, im.values.data())));
+            }
+            return out;
+        },
+        py::arg("path"));
 
     py::class_<airlight::Renderer>(m, "Renderer")
         .def(py::init([](const std::string& backend) {

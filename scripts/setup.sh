@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config python3 python3-dev python3-venv
           libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev nlohmann-json3-dev libeigen3-dev libglfw3-dev
-          clang-format)
+          libopenexr-dev clang-format)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
@@ -27,9 +27,12 @@ if [ ! -x .venv/bin/python ]; then
     "$python" -m venv .venv
 fi
 .venv/bin/python -m pip install -q --upgrade pip
+# PythonicDISORT: an independent DISORT, the multiple-scattering solver's reference in tests.
+# OpenEXR (the official bindings): only the independent reader of tests/python/test_exr.py;
+# airlight itself writes and reads EXR through the C++ library (libopenexr-dev).
 .venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib colour-science \
     "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy \
-    PythonicDISORT  # an independent DISORT, the multiple-scattering solver's reference in tests
+    PythonicDISORT "OpenEXR>=3.5,<4"
 # --no-build-isolation: build with the tools just installed in .venv
 # (incremental: the build directory build/python is kept between runs).
 .venv/bin/python -m pip install -q --no-build-isolation .

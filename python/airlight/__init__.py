@@ -19,7 +19,7 @@ modules that hold them are private (their layout may change):
 - ``_rendering``: backends and the :class:`Renderer`;
 - ``_display``: the display stage (exposure, tone curves, sRGB);
 - ``_glare``: the eye's diffraction glare;
-- ``_image_io``: PNG and PFM files;
+- ``_image_io``: PNG, PFM and OpenEXR files;
 - ``_lights``: light helpers (headlights);
 - ``_rainbow``: the raindrops' phase function for sunlight;
 - ``_checks``: the argument checks they share;
@@ -37,7 +37,7 @@ from ._display import (
     tone_curve,
 )
 from ._glare import GlareLike, glare
-from ._image_io import load_pfm, save_pfm, save_png
+from ._image_io import load_exr, load_pfm, save_exr, save_pfm, save_png
 from ._lights import headlights
 from ._rainbow import rainbow_phase
 from ._rendering import (
@@ -71,12 +71,14 @@ __all__ = [
     "gl_unavailable_reason",
     "glare",
     "headlights",
+    "load_exr",
     "load_pfm",
     "load_scene",
     "preset",
     "preset_names",
     "rainbow_phase",
     "render",
+    "save_exr",
     "save_pfm",
     "save_png",
     "table_stats",

@@ -154,7 +154,7 @@ def test_demo_bad_exposure_exits_nonzero_with_one_line(tmp_path: Path, scene_fil
     _assert_one_line_error(proc, "--exposure")
 
 
-@pytest.mark.parametrize("name", ["x.jpg", "x.PNG.txt", "x", "x.exr"])
+@pytest.mark.parametrize("name", ["x.jpg", "x.PNG.txt", "x", "x.tif", "x.EXR"])
 def test_demo_unsupported_output_extension_exits_nonzero_with_one_line(
         tmp_path: Path, scene_file: Path, name: str) -> None:
     out = tmp_path / name
