@@ -4,6 +4,7 @@
 // a one-line message.
 #include <unistd.h>
 
+#include <algorithm>
 #include <atomic>
 #include <cctype>
 #include <chrono>
@@ -39,6 +40,8 @@ const char* kUsage =
     "usage: airlight-demo --scene S.json --out F.png|F.pfm|F.exr [--backend auto|gl|cpu]\n"
     "                     [--width W] [--height H] (one alone: the scene's aspect ratio)\n"
     "  F.pfm, F.exr: linear radiance (EXR: channels R, G, B, float32; --half: half floats)\n"
+    "  more render outputs in the EXR (README \"Render outputs\"; 'layers': every layer):\n"
+    "                     --out F.exr --outputs depth,transmittance,layers,...\n"
     "  an interactive window (GLFW and a display; --out optional: the last frame shown\n"
     "  is written there on closing):\n"
     "                     --scene S.json --window [--out F.png|F.pfm|F.exr]\n"
@@ -57,7 +60,8 @@ struct Options {
     std::string scene, out, backend = "auto", sequence;
     int width = 0, height = 0;
     bool window = false;
-    bool half = false;  // --half: an EXR's channels as half floats
+    bool half = false;                 // --half: an EXR's channels as half floats
+    std::vector<std::string> outputs;  // --outputs: render outputs beside the radiance (EXR only)
     // Display overrides (empty: the scene's).
     std::string exposure, tonemap, pupil;
     float white = 0.0f;
@@ -118,6 +122,32 @@ double parse_number(const std::string& flag, const char* text, double lo, double
     return value;
 }
 
+// The render outputs of --outputs (a comma-separated list of names of
+// airlight::render_outputs(), "layers" for every layer), each once, in order.
+std::vector<std::string> parse_outputs(const std::string& list) {
+    std::vector<std::string> names;
+    auto add = [&names](const std::string& name) {
+        if (std::find(names.begin(), names.end(), name) == names.end()) names.push_back(name);
+    };
+    size_t start = 0;
+    while (start <= list.size()) {
+        const size_t comma = std::min(list.find(',', start), list.size());
+        const std::string name = list.substr(start, comma - start);
+        start = comma + 1;
+        bool known = false;
+        std::string all;
+        for (const airlight::RenderOutput& o : airlight::render_outputs()) {
+            all += (all.empty() ? "" : ", ") + o.name;
+            if (name == o.name || (name == "layers" && o.layer)) {
+                add(o.name);
+                known = true;
+            }
+        }
+        if (!known) fail("--outputs: unknown output '" + name + "'; one of " + all + ", or layers");
+    }
+    return names;
+}
+
 Options parse_args(int argc, char** argv) {
     Options o;
     for (int i = 1; i < argc; ++i) {
@@ -153,6 +183,8 @@ Options parse_args(int argc, char** argv) {
             o.scene = value;
         else if (arg == "--out")
             o.out = value;
+        else if (arg == "--outputs")
+            o.outputs = parse_outputs(value);
         else if (arg == "--backend")
             o.backend = value;
         else if (arg == "--width")
@@ -343,6 +375,8 @@ int main(int argc, char** argv) {
     }
     if (o.half && (o.window || !o.sequence.empty() || !ends_with(o.out, ".exr")))
         fail("--half needs --out F.exr (and neither --window nor --sequence)");
+    if (!o.outputs.empty() && (o.window || !o.sequence.empty() || !ends_with(o.out, ".exr")))
+        fail("--outputs needs --out F.exr (and neither --window nor --sequence)");
     if (o.sequence.empty() && !o.out.empty()) {
         // A bad destination is reported before rendering, not after.
         const std::filesystem::path dir = std::filesystem::path(o.out).parent_path();
@@ -393,15 +427,23 @@ int main(int argc, char** argv) {
         }
         Renderer renderer(backend);
         const auto start = std::chrono::steady_clock::now();
-        const Image image = renderer.render(scene, &interrupted);
+        bool extra_outputs = false;
+        for (const std::string& name : o.outputs) extra_outputs = extra_outputs || name != "radiance";
+        const Image image = renderer.render(scene, &interrupted, extra_outputs);
         const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
         if (ends_with(o.out, ".pfm")) {
             write_pfm(o.out, image);
             print_report(o.out, image, backend, ms, nullptr);
         } else if (ends_with(o.out, ".exr")) {
-            // The render's outputs as named images of one EXR file (`radiance`: the channels R, G, B);
-            // further outputs (depth, transmittance) are more entries of this list.
+            // The render's outputs as named images of one EXR file (`radiance`: the channels R, G, B),
+            // the radiance always, then those of --outputs.
             std::vector<NamedImage> outputs = {{"radiance", 3, image.rgb}};
+            for (const RenderOutput& output : render_outputs()) {
+                if (output.name == "radiance" ||
+                    std::find(o.outputs.begin(), o.outputs.end(), output.name) == o.outputs.end())
+                    continue;
+                outputs.push_back({output.name, output.components, output_values(image, output.name)});
+            }
             write_exr(o.out, image.width, image.height, outputs, o.half);
             print_report(o.out, image, backend, ms, nullptr);
         } else {

@@ -5,6 +5,7 @@ radiance on every preset and on random scenes, both backends agreeing, and the
 
 from __future__ import annotations
 
+import json
 import math
 from typing import Any
 
@@ -338,3 +339,37 @@ def test_bad_outputs_argument_names_the_entry(scene_factory, outputs, error, mes
     with pytest.raises(error) as e:
         airlight.render(scene_factory(film=SMALL), "cpu", outputs=outputs)
     assert str(e.value).startswith(message)
+
+
+# ---- the demo's --outputs ----------------------------------------------------------------
+
+def test_demo_writes_the_outputs_asked_for_into_its_exr(tmp_path, scene_factory) -> None:
+    from test_exr import _demo
+
+    scene = scene_factory(film=SMALL, quality={"multiple_scattering": False})
+    (tmp_path / "s.json").write_text(json.dumps(scene))
+    out = tmp_path / "x.exr"
+    proc = _demo("--scene", str(tmp_path / "s.json"), "--out", str(out), "--backend", "cpu",
+                 "--outputs", "depth,layers,transmittance")
+    assert proc.returncode == 0, proc.stderr
+    from_demo = airlight.load_exr(out)
+    assert set(from_demo) == {"radiance", "depth", "transmittance", *airlight.LAYERS}
+    from_api = airlight.render(scene, "cpu", outputs=list(from_demo))
+    for name, values in from_api.items():
+        np.testing.assert_array_equal(from_demo[name], values, err_msg=name)
+    assert np.isinf(from_demo["depth"]).any()
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--outputs", "depth,albedo"], "--outputs: unknown output 'albedo'"),
+    (["--outputs", "depth", "--out-png"], "--outputs needs --out F.exr"),
+])
+def test_demo_bad_outputs_exit_with_one_line(tmp_path, scene_factory, args, message) -> None:
+    from test_exr import _demo
+
+    (tmp_path / "s.json").write_text(json.dumps(scene_factory(film=SMALL)))
+    out = tmp_path / ("x.png" if "--out-png" in args else "x.exr")
+    proc = _demo("--scene", str(tmp_path / "s.json"), "--out", str(out),
+                 *[a for a in args if a != "--out-png"])
+    assert proc.returncode != 0 and not out.exists()
+    assert len(proc.stderr.splitlines()) == 1 and message in proc.stderr, proc.stderr
