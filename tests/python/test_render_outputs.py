@@ -373,3 +373,12 @@ def test_demo_bad_outputs_exit_with_one_line(tmp_path, scene_factory, args, mess
                  *[a for a in args if a != "--out-png"])
     assert proc.returncode != 0 and not out.exists()
     assert len(proc.stderr.splitlines()) == 1 and message in proc.stderr, proc.stderr
+
+
+def test_readme_documents_every_output() -> None:
+    from pathlib import Path
+
+    readme = (Path(__file__).resolve().parents[2] / "README.md").read_text()
+    section = readme.split("### Render outputs", 1)[1].split("\n## ", 1)[0]
+    rows = {line.split("`")[1] for line in section.splitlines() if line.startswith("| `")}
+    assert rows == set(airlight.OUTPUTS), rows ^ set(airlight.OUTPUTS)
