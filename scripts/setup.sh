@@ -30,9 +30,10 @@ fi
 # PythonicDISORT: an independent DISORT, the multiple-scattering solver's reference in tests.
 # OpenEXR (the official bindings): only the independent reader of tests/python/test_exr.py;
 # airlight itself writes and reads EXR through the C++ library (libopenexr-dev).
+# ray, pyyaml, tqdm: the batch sweeps (airlight.batch; pyproject's "batch" extra); types-PyYAML for mypy.
 .venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib colour-science \
     "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy \
-    PythonicDISORT "OpenEXR>=3.5,<4"
+    PythonicDISORT "OpenEXR>=3.5,<4" "ray>=2.9" "pyyaml>=6" "tqdm>=4" types-PyYAML types-tqdm
 # --no-build-isolation: build with the tools just installed in .venv
 # (incremental: the build directory build/python is kept between runs).
 .venv/bin/python -m pip install -q --no-build-isolation .
