@@ -23,6 +23,7 @@
 #include "airlight_tables.hpp"
 #include "phase_tables.hpp"
 #include "plane_parallel.hpp"
+#include "point_source.hpp"
 #include "rainbow.hpp"
 #include "scene_json.hpp"
 #include "sky.hpp"
@@ -497,6 +498,28 @@ PYBIND11_MODULE(_core, m) {
             return d;
         },
         py::arg("samples") = 0, py::arg("seed") = 1, py::arg("wavelengths") = std::vector<int>{});
+    // The point lamps' multiple-scattering table (effects/multiple_scattering/point_source.hpp), the
+    // cached one a frame with this HG g and per-channel albedo uses: log L rows, then log E rows
+    // (lamp_ms_math.glsl). For tests.
+    m.def(
+        "lamp_ms_table",
+        [](double g, const std::array<double, 3>& albedo) {
+            if (!(g > -1.0 && g < 1.0)) throw py::value_error("g: must be in (-1, 1)");
+            for (double a : albedo)
+                if (!(a >= 0.0 && a <= 1.0)) throw py::value_error("albedo: each must be in [0, 1]");
+            airlight::Phase phase;
+            phase.type = airlight::PhaseType::hg;
+            phase.g = float(g);
+            std::shared_ptr<const airlight::Table2D> t;
+            {
+                py::gil_scoped_release release;
+                t = airlight::lamp_ms_table(airlight::point_source_phase(phase), albedo);
+            }
+            py::array_t<float> out({t->height, t->width, 4});
+            std::memcpy(out.mutable_data(), t->texels.data(), t->texels.size() * sizeof(float));
+            return out;
+        },
+        py::arg("g"), py::arg("albedo"));
     m.def("rainbow_rgb_weights", [](int count) {
         if (!airlight::is_rainbow_wavelength_count(count))
             throw py::value_error(std::string("count: must be ") + airlight::RAINBOW_WAVELENGTH_COUNTS);

@@ -20,7 +20,7 @@ set(EFFECT_HOOKS
     surface_irradiance=ms_surface_irradiance)  # the diffuse sky light on surfaces
 
 # ---- Night (issue 18): point lamps' multiple scattering in the homogeneous
-# medium (physics.md sections 12 to 14; effects/multiple_scattering/docs/lamps.md),
+# medium (physics.md sections 10 to 13; effects/multiple_scattering/docs/lamps.md),
 # switched by the same quality.multiple_scattering.
 list(APPEND EFFECT_SOURCES point_source.cpp lamp_ms_frame.cpp ms_frame.cpp)
 list(APPEND EFFECT_GLSL_MATH lamp_ms_math.glsl)
@@ -28,7 +28,8 @@ list(APPEND EFFECT_GLSL_TERMS lamp_ms_terms.glsl)
 list(APPEND EFFECT_FEATURES
     lamp_multiple_scattering=LAMP_MULTIPLE_SCATTERING)  # point lamps: light scattered twice or more
 list(APPEND EFFECT_TABLES
-    lamp_ms_glow)  # log L(tau, gamma) per albedo channel (lamp_ms_math.glsl)
+    lamp_ms_glow)  # log L(tau, gamma), then log E(tau, beta), per albedo channel (lamp_ms_math.glsl)
 list(APPEND EFFECT_HOOKS
-    view_glow=lamp_ms_view_glow)
+    view_glow=lamp_ms_view_glow
+    surface_irradiance=lamp_ms_surface_irradiance)  # the lamps' diffuse light on surfaces (physics.md section 13)
 set(EFFECT_FRAME 1)  # ms_frame.cpp: pack_multiple_scattering_frame (the lamps' switch and table)

@@ -1,5 +1,5 @@
 // Multiple scattering of a point lamp in an infinite homogeneous medium
-// (effects/multiple_scattering/physics.md sections 10 to 12; measurements:
+// (effects/multiple_scattering/physics.md sections 10 to 13; measurements:
 // effects/multiple_scattering/docs/lamps.md).
 #include "point_source.hpp"
 
@@ -372,13 +372,57 @@ std::array<double, 3> point_source_radiance(const PointSourceField& field, doubl
     return sum;
 }
 
+double hemisphere_kernel(double beta, double gamma) {
+    // a + b cos phi with b >= 0: positive for every phi, for none, or for |phi| < phi0 = acos(-a / b),
+    // where the integral is 2 (a phi0 + b sin phi0) (section 13, eq. 13.3).
+    const double a = std::cos(beta) * std::cos(gamma), b = std::abs(std::sin(beta) * std::sin(gamma));
+    if (b <= std::abs(a)) return a > 0.0 ? 2.0 * kPi * a : 0.0;
+    const double c = -a / b, phi0 = std::acos(c);
+    return 2.0 * (a * phi0 + b * std::sqrt(std::max(0.0, 1.0 - c * c)));
+}
+
+namespace {
+
+// The angle gamma of the glow rows' coordinate Y (the inverse of lamp_ms_y, without the first
+// row's clamp) and d gamma / dY.
+double gamma_of_y(double Y) {
+    const double c = std::log(1.0 + kPi / double(shader::LAMP_MS_GAMMA0));
+    return double(shader::LAMP_MS_GAMMA0) * std::expm1(c * Y);
+}
+double dgamma_dy(double Y) {
+    const double c = std::log(1.0 + kPi / double(shader::LAMP_MS_GAMMA0));
+    return c * (double(shader::LAMP_MS_GAMMA0) + gamma_of_y(Y));
+}
+
+// Sub-steps of the surface rows' quadrature per interval of the glow rows (section 13).
+constexpr int kSurfaceSubsteps = 16;
+
+}  // namespace
+
+std::vector<std::array<double, 3>> point_source_irradiance(const PointSourceField& field, double tau,
+                                                           const std::vector<double>& betas, int steps) {
+    // Midpoint rule in the glow rows' coordinate Y (fine near the lamp's direction, where L grows
+    // as log 1 / gamma), L from the line integral (11.4) at every point.
+    std::vector<std::array<double, 3>> out(betas.size(), {0.0, 0.0, 0.0});
+    for (int k = 0; k < steps; ++k) {
+        const double Y = (k + 0.5) / steps, gamma = gamma_of_y(Y);
+        const std::array<double, 3> l = point_source_radiance(field, tau, gamma);
+        const double w = std::sin(gamma) * dgamma_dy(Y) / steps;
+        for (size_t i = 0; i < betas.size(); ++i) {
+            const double kw = w * hemisphere_kernel(betas[i], gamma);
+            for (int c = 0; c < 3; ++c) out[i][size_t(c)] += kw * l[size_t(c)];
+        }
+    }
+    return out;
+}
+
 Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
                             const PointSourceSettings& settings) {
     using namespace shader;
     const PointSourceField field = point_source_field(phase, albedo, settings);
     Table2D t;
     t.width = LAMP_MS_NX;
-    t.height = LAMP_MS_NY;
+    t.height = LAMP_MS_NY + LAMP_MS_NB;
     t.channels = 4;
     t.texels.assign(size_t(t.width) * size_t(t.height) * 4, 0.0f);
     const double tau_min = double(LAMP_MS_TAU_MIN), tau_lin = double(LAMP_MS_TAU_LIN);
@@ -392,23 +436,70 @@ Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<doub
                 std::max(tau - (std::log(tau / tau_min) + tau / tau_lin - w) / (1.0 / tau + 1.0 / tau_lin), 0.5 * tau);
         return tau;
     };
+    const double log_floor = double(LAMP_MS_LOG_FLOOR);
     const double log_gamma = std::log(1.0 + kPi / double(LAMP_MS_GAMMA0));
+    std::vector<std::array<double, 3>> log_l(size_t(LAMP_MS_NX) * size_t(LAMP_MS_NY));
     numerics::parallel_for(
-        t.width * t.height,
+        LAMP_MS_NX * LAMP_MS_NY,
         [&](int i) {
             const int ix = i % t.width, iy = i / t.width;
             // The inverses of lamp_ms_x and lamp_ms_y (lamp_ms_math.glsl).
             const double tau = ix == 0 ? tau_min : tau_at(double(ix) / (t.width - 1));
-            const double gamma = std::clamp(double(LAMP_MS_GAMMA0) * std::expm1(log_gamma * iy / (t.height - 1)),
+            const double gamma = std::clamp(double(LAMP_MS_GAMMA0) * std::expm1(log_gamma * iy / (LAMP_MS_NY - 1)),
                                             double(LAMP_MS_GAMMA_MIN), kPi);
             const std::array<double, 3> l = point_source_radiance(field, tau, gamma);
             float* texel = &t.texels[size_t(i) * 4];
-            for (int c = 0; c < 3; ++c)
-                texel[c] =
-                    float(std::max(l[size_t(c)] > 0.0 ? std::log(l[size_t(c)]) : -1e30, double(LAMP_MS_LOG_FLOOR)));
+            for (int c = 0; c < 3; ++c) {
+                log_l[size_t(i)][size_t(c)] = std::max(l[size_t(c)] > 0.0 ? std::log(l[size_t(c)]) : -1e30, log_floor);
+                texel[c] = float(log_l[size_t(i)][size_t(c)]);
+            }
             texel[3] = 0.0f;
         },
         settings.threads);
+    // The surface rows (section 13): E(tau, beta) = int L sin gamma K(beta, gamma) dgamma over the
+    // column's own rows, log L linear in Y between them as the shader reads it; kSurfaceSubsteps
+    // midpoints per interval.
+    constexpr int nsub = (LAMP_MS_NY - 1) * kSurfaceSubsteps;
+    std::vector<double> sub_gamma(nsub), sub_weight(nsub);
+    for (int k = 0; k < nsub; ++k) {
+        const double Y = (k + 0.5) / nsub;
+        sub_gamma[size_t(k)] = gamma_of_y(Y);
+        sub_weight[size_t(k)] = std::sin(sub_gamma[size_t(k)]) * dgamma_dy(Y) / nsub;
+    }
+    std::vector<double> log_e(size_t(LAMP_MS_NX) * size_t(LAMP_MS_NB) * 3);
+    numerics::parallel_for(
+        LAMP_MS_NX * LAMP_MS_NB,
+        [&](int i) {
+            const int ix = i % LAMP_MS_NX, ib = i / LAMP_MS_NX;
+            const double beta = kPi * ib / (LAMP_MS_NB - 1);
+            double e[3] = {0.0, 0.0, 0.0};
+            for (int k = 0; k < nsub; ++k) {
+                const double kw = sub_weight[size_t(k)] * hemisphere_kernel(beta, sub_gamma[size_t(k)]);
+                if (kw <= 0.0) continue;
+                const int iy = k / kSurfaceSubsteps;
+                const double a = ((k % kSurfaceSubsteps) + 0.5) / kSurfaceSubsteps;
+                const auto& l0 = log_l[size_t(iy) * size_t(LAMP_MS_NX) + size_t(ix)];
+                const auto& l1 = log_l[size_t(iy + 1) * size_t(LAMP_MS_NX) + size_t(ix)];
+                for (int c = 0; c < 3; ++c)
+                    if (l0[size_t(c)] > log_floor || l1[size_t(c)] > log_floor)
+                        e[c] += kw * std::exp(l0[size_t(c)] * (1.0 - a) + l1[size_t(c)] * a);
+            }
+            for (int c = 0; c < 3; ++c)
+                log_e[size_t(i) * 3 + size_t(c)] = e[c] > 0.0 ? std::max(std::log(e[c]), log_floor) : log_floor;
+        },
+        settings.threads);
+    for (int ix = 0; ix < LAMP_MS_NX; ++ix) {
+        double bound = log_floor;
+        for (int ib = 0; ib < LAMP_MS_NB; ++ib)
+            for (int c = 0; c < 3; ++c)
+                bound = std::max(bound, log_e[(size_t(ib) * size_t(LAMP_MS_NX) + size_t(ix)) * 3 + size_t(c)]);
+        for (int ib = 0; ib < LAMP_MS_NB; ++ib) {
+            float* texel = &t.texels[(size_t(LAMP_MS_NY + ib) * size_t(t.width) + size_t(ix)) * 4];
+            for (int c = 0; c < 3; ++c)
+                texel[c] = float(log_e[(size_t(ib) * size_t(LAMP_MS_NX) + size_t(ix)) * 3 + size_t(c)]);
+            texel[3] = float(bound);  // the culling bound (rounding is monotone: no row's float exceeds it)
+        }
+    }
     return t;
 }
 

@@ -1,5 +1,5 @@
 // Multiple scattering of an isotropic point lamp in an infinite homogeneous
-// medium (effects/multiple_scattering/physics.md sections 10 to 12): the
+// medium (effects/multiple_scattering/physics.md sections 10 to 13): the
 // radiance field of the light scattered at least twice, built by a seeded
 // Monte Carlo of the in-scattering source and a line integral per table entry,
 // and the table the shading pass reads (effects/multiple_scattering/lamp_ms_math.glsl).
@@ -74,8 +74,23 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
 // per channel.
 std::array<double, 3> point_source_radiance(const PointSourceField& field, double tau, double gamma);
 
+// The azimuthal integral of the cosine factor (section 13): int_0^{2 pi}
+// max(cos beta cos gamma + sin beta sin gamma cos phi, 0) dphi, the weight of
+// the radiance arriving from angle gamma off the lamp's direction on a surface
+// whose normal is beta off it.
+double hemisphere_kernel(double beta, double gamma);
+
+// The irradiance of the light scattered at least twice (optical units, unit
+// intensity) on a surface element at optical distance tau from the lamp, its
+// normal at angle beta from the lamp's direction: E = int L(tau, gamma) sin gamma
+// K(beta, gamma) dgamma (section 13), for each of `betas`, by `steps` line
+// integrals (11.4) in gamma: the direct quadrature the table's rows are checked against.
+std::vector<std::array<double, 3>> point_source_irradiance(const PointSourceField& field, double tau,
+                                                           const std::vector<double>& betas, int steps);
+
 // The table of log L over (tau, gamma) (lamp_ms_math.glsl's coordinates),
-// RGBA texels: one albedo per channel.
+// RGBA texels: one albedo per channel; then the rows of log E(tau, beta)
+// (section 13), computed from the same column's log L rows.
 Table2D build_lamp_ms_table(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
                             const PointSourceSettings& settings = {});
 
