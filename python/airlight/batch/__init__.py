@@ -101,6 +101,8 @@ def run(spec: SpecLike | BatchSpec, out: str | os.PathLike[str], *, workers: int
     s = spec if isinstance(spec, BatchSpec) else load_spec(spec)
     out_dir = Path(out)
     item_dir(out_dir).mkdir(parents=True, exist_ok=True)
+    for stale in item_dir(out_dir).glob(".*.tmp*"):  # a killed run's unfinished file
+        stale.unlink()
     items = expand(s)
     todo = [it for it in items if not (resume and metadata_path(out_dir, it.id).exists())]
     skipped = len(items) - len(todo)
