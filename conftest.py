@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import json
+import subprocess
 import sys
 from pathlib import Path
 from typing import Any, Callable
@@ -129,6 +130,29 @@ def make_scene(**overrides: Any) -> dict[str, Any]:
     for key in drop:
         scene.pop(key, None)
     return scene
+
+
+DEMO = Path(sys.executable).with_name("airlight-demo")
+
+
+def run_demo(*args: str) -> subprocess.CompletedProcess:
+    """Runs the installed airlight-demo (beside this Python) with ``args``; skips the test
+    where it is not installed."""
+    if not DEMO.exists():
+        pytest.skip(f"{DEMO} is not installed")
+    return subprocess.run([str(DEMO), *args], capture_output=True, text=True, timeout=60)
+
+
+@pytest.fixture
+def scene_file(tmp_path: Path, scene_factory) -> Path:
+    """The base scene in a fog of per-channel extinction over a coloured background, as a
+    file for the demo. Single scattering, as the API renders it in these tests (above); the
+    demo reads the file as is."""
+    path = tmp_path / "scene.json"
+    scene = scene_factory(medium={"sigma_t": [0.01, 0.05, 0.2]}, background=[0.2, 0.3, 0.4],
+                          quality={"multiple_scattering": False})
+    path.write_text(json.dumps(scene))
+    return path
 
 
 @pytest.fixture

@@ -5,9 +5,6 @@ back, the demo's ``--out x.exr`` against the API's render, and the errors."""
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 from typing import Any
 
@@ -15,8 +12,8 @@ import numpy as np
 import pytest
 
 import airlight
+from conftest import run_demo
 
-DEMO = Path(sys.executable).with_name("airlight-demo")
 HALF_MAX = 65504.0
 
 
@@ -247,25 +244,9 @@ def test_load_exr_of_a_truncated_file_raises_oserror(tmp_path: Path) -> None:
 
 # --- the demo -----------------------------------------------------------------------------------------
 
-def _demo(*args: str) -> subprocess.CompletedProcess:
-    if not DEMO.exists():
-        pytest.skip(f"{DEMO} is not installed")
-    return subprocess.run([str(DEMO), *args], capture_output=True, text=True, timeout=60)
-
-
-@pytest.fixture
-def scene_file(tmp_path: Path, scene_factory) -> Path:
-    path = tmp_path / "scene.json"
-    # Single scattering, as the API renders it in these tests (conftest.py); the demo reads the file as is.
-    scene = scene_factory(medium={"sigma_t": [0.01, 0.05, 0.2]}, background=[0.2, 0.3, 0.4],
-                          quality={"multiple_scattering": False})
-    path.write_text(json.dumps(scene))
-    return path
-
-
 def test_demo_exr_equals_the_cpu_render(tmp_path: Path, scene_file: Path) -> None:
     out = tmp_path / "x.exr"
-    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "64",
+    proc = run_demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "64",
                  "--height", "48")
     assert proc.returncode == 0, proc.stderr
     assert str(out) in proc.stdout
@@ -279,7 +260,7 @@ def test_demo_exr_equals_the_cpu_render(tmp_path: Path, scene_file: Path) -> Non
 
 def test_demo_exr_half_is_the_cpu_render_in_half_precision(tmp_path: Path, scene_file: Path) -> None:
     out = tmp_path / "x.exr"
-    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "32",
+    proc = run_demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "32",
                  "--height", "24", "--half")
     assert proc.returncode == 0, proc.stderr
     from_api = airlight.render(str(scene_file), backend="cpu", width=32, height=24)
@@ -291,13 +272,13 @@ def test_demo_exr_half_is_the_cpu_render_in_half_precision(tmp_path: Path, scene
 @pytest.mark.parametrize("out", ["x.png", "x.pfm"])
 def test_demo_half_without_an_exr_output_exits_nonzero_with_one_line(tmp_path: Path, scene_file: Path,
                                                                      out: str) -> None:
-    proc = _demo("--scene", str(scene_file), "--out", str(tmp_path / out), "--half")
+    proc = run_demo("--scene", str(scene_file), "--out", str(tmp_path / out), "--half")
     assert proc.returncode != 0
     assert len(proc.stderr.splitlines()) == 1 and "--half" in proc.stderr, proc.stderr
     assert not (tmp_path / out).exists()
 
 
 def test_demo_help_documents_exr_and_half() -> None:
-    proc = _demo("--help")
+    proc = run_demo("--help")
     assert proc.returncode == 0
     assert "F.exr" in proc.stdout and "--half" in proc.stdout

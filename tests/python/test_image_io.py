@@ -2,9 +2,6 @@
 
 from __future__ import annotations
 
-import json
-import subprocess
-import sys
 from pathlib import Path
 
 import numpy as np
@@ -12,8 +9,7 @@ import pytest
 from PIL import Image
 
 import airlight
-
-DEMO = Path(sys.executable).with_name("airlight-demo")
+from conftest import run_demo
 
 
 def _srgb8(values) -> np.ndarray:
@@ -138,25 +134,9 @@ def test_load_pfm_rejects_other_files(tmp_path: Path) -> None:
         airlight.load_pfm(path)
 
 
-def _demo(*args: str) -> subprocess.CompletedProcess:
-    if not DEMO.exists():
-        pytest.skip(f"{DEMO} is not installed")
-    return subprocess.run([str(DEMO), *args], capture_output=True, text=True, timeout=60)
-
-
-@pytest.fixture
-def scene_file(tmp_path: Path, scene_factory) -> Path:
-    path = tmp_path / "scene.json"
-    # Single scattering, as the API renders it in these tests (conftest.py); the demo reads the file as is.
-    scene = scene_factory(medium={"sigma_t": [0.01, 0.05, 0.2]}, background=[0.2, 0.3, 0.4],
-                          quality={"multiple_scattering": False})
-    path.write_text(json.dumps(scene))
-    return path
-
-
 def test_demo_png_is_the_display_stage_of_the_cpu_render(tmp_path: Path, scene_file: Path) -> None:
     out = tmp_path / "x.png"
-    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "64",
+    proc = run_demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "64",
                  "--height", "48")
     assert proc.returncode == 0, proc.stderr
     with Image.open(out) as png:
@@ -179,7 +159,7 @@ def test_demo_png_is_the_display_stage_of_the_cpu_render(tmp_path: Path, scene_f
 def test_demo_png_applies_the_display_flags(tmp_path: Path, scene_file: Path, flags: list[str],
                                             kwargs: dict) -> None:
     out = tmp_path / "x.png"
-    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "32",
+    proc = run_demo("--scene", str(scene_file), "--out", str(out), "--backend", "cpu", "--width", "32",
                  "--height", "24", *flags)
     assert proc.returncode == 0, proc.stderr
     with Image.open(out) as png:
@@ -192,7 +172,7 @@ def test_demo_png_applies_the_display_flags(tmp_path: Path, scene_file: Path, fl
 
 def test_demo_pfm_equals_the_render_output(tmp_path: Path, scene_file: Path, backend: str) -> None:
     out = tmp_path / "x.pfm"
-    proc = _demo("--scene", str(scene_file), "--out", str(out), "--backend", backend, "--width", "64",
+    proc = run_demo("--scene", str(scene_file), "--out", str(out), "--backend", backend, "--width", "64",
                  "--height", "48")
     assert proc.returncode == 0, proc.stderr
     from_demo = airlight.load_pfm(out)

@@ -16,6 +16,7 @@ from hypothesis import strategies as st
 from reference import camera_rays
 
 import airlight
+from conftest import run_demo
 
 SMALL = {"width": 40, "height": 30}
 
@@ -344,12 +345,10 @@ def test_bad_outputs_argument_names_the_entry(scene_factory, outputs, error, mes
 # ---- the demo's --outputs ----------------------------------------------------------------
 
 def test_demo_writes_the_outputs_asked_for_into_its_exr(tmp_path, scene_factory) -> None:
-    from test_exr import _demo
-
     scene = scene_factory(film=SMALL, quality={"multiple_scattering": False})
     (tmp_path / "s.json").write_text(json.dumps(scene))
     out = tmp_path / "x.exr"
-    proc = _demo("--scene", str(tmp_path / "s.json"), "--out", str(out), "--backend", "cpu",
+    proc = run_demo("--scene", str(tmp_path / "s.json"), "--out", str(out), "--backend", "cpu",
                  "--outputs", "depth,layers,transmittance")
     assert proc.returncode == 0, proc.stderr
     from_demo = airlight.load_exr(out)
@@ -365,11 +364,9 @@ def test_demo_writes_the_outputs_asked_for_into_its_exr(tmp_path, scene_factory)
     (["--outputs", "depth", "--out-png"], "--outputs needs --out F.exr"),
 ])
 def test_demo_bad_outputs_exit_with_one_line(tmp_path, scene_factory, args, message) -> None:
-    from test_exr import _demo
-
     (tmp_path / "s.json").write_text(json.dumps(scene_factory(film=SMALL)))
     out = tmp_path / ("x.png" if "--out-png" in args else "x.exr")
-    proc = _demo("--scene", str(tmp_path / "s.json"), "--out", str(out),
+    proc = run_demo("--scene", str(tmp_path / "s.json"), "--out", str(out),
                  *[a for a in args if a != "--out-png"])
     assert proc.returncode != 0 and not out.exists()
     assert len(proc.stderr.splitlines()) == 1 and message in proc.stderr, proc.stderr
