@@ -1,8 +1,8 @@
 """Writes effects/multiple_scattering/tests/data/lamp_ms_surface_reference.json: the irradiance of a point
 lamp's multiply scattered light on a surface element, by the independent photon tracer
 effects/multiple_scattering/tests/surface_mc.py, over tau 0.1 to 20, beta 0 to 180 degrees, g 0 to 0.9
-(effects/multiple_scattering/physics.md section 13; docs/lamps.md section 5), then prints the table's
-deviation from it. Usage:
+(effects/multiple_scattering/physics.md section 13; effects/multiple_scattering/docs/lamps.md
+section 5), then prints the table's deviation from it. Usage:
 
     .venv/bin/python effects/multiple_scattering/bench/make_surface_reference.py [--photons N] [--print-only]
 """

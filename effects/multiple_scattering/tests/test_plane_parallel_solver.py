@@ -48,7 +48,10 @@ def test_matches_live_disort(case):
     pytest.importorskip("PythonicDISORT")
     live = disort_cases.run_pythonic_disort(case)
     stored = STORED["cases"][case["name"]]
-    assert np.allclose(live["flux_up"], stored["flux_up"], rtol=1e-9, atol=1e-12)
+    # To 1e-6: the stored values came from an earlier numpy/scipy, whose LAPACK eigensolvers give
+    # PythonicDISORT differences up to 1.3e-8 relative (seen on numpy 2.4.6, scipy 1.17.1); the
+    # comparison that matters, against airlight's solver, is RADIANCE_TOL below.
+    assert np.allclose(live["flux_up"], stored["flux_up"], rtol=1e-6, atol=1e-12)
     ours = disort_cases.run_airlight(case)
     d = disort_cases.worst_differences(ours, live, disort_cases.incident_flux(case))
     assert max(d.values()) < RADIANCE_TOL, d
