@@ -17,7 +17,7 @@ set(EFFECT_TABLES
     photo)  # per pixel (row 0 on top): the photo's linear RGB and its depth along the ray (m; NO_HIT: none)
 set(EFFECT_FRAME 1)
 set(EFFECT_SCENE_HEADER photo_scene.hpp)
-set(EFFECT_SCENE_MEMBERS "Backplate backplate" "Rgb atmospheric_light")
+set(EFFECT_SCENE_MEMBERS "Backplate backplate" "Rgb atmospheric_light{0.0f}")  # glm vectors are not zeroed by default
 set(EFFECT_SCENE_KEYS atmospheric_light)
 set(EFFECT_LAYERS
     "atmospheric_light=the constant atmospheric light A of the homogeneous medium (the scene's atmospheric_light) scattered toward the camera: A (1 - exp(-sigma_t depth))")
