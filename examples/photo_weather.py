@@ -46,7 +46,8 @@ def main() -> None:
     before_after = np.concatenate([image, out.display], axis=1)
     picture = Image.fromarray(before_after).resize((2 * 320, 180), Image.NEAREST)
     picture.save(ROOT / "docs/images/photo_weather.png")
-    print("mean transmittance", float(out.transmittance.mean()), "mean in-scattered", float(out.inscattered.mean()))
+    print("mean transmittance", float(out.transmittance.mean()),
+          "mean in-scattered", float(out.inscattered.mean()))
 
 
 if __name__ == "__main__":
