@@ -35,6 +35,13 @@
 #                      pixel_cores         vec3 f(int x, int row, vec3 radiance):
 #                                          the pixel's radiance with sub-pixel
 #                                          emitters composited over it
+#                      backplate           bool f(int x, int row, INOUT(vec3) dir,
+#                                          INOUT(float) t_end, INOUT(vec3) radiance):
+#                                          true when pixel (x, row)'s ray (dir, which
+#                                          it may replace) ends at t_end with that
+#                                          radiance (an image: a photo and its depth)
+#                                          in place of the surfaces, emitters and
+#                                          cores; the first that returns true wins
 #   EFFECT_FEATURES    shader switches, each name=MACRO: a bool of
 #                      shader::Features and a compile-time constant MACRO in
 #                      the GL variant / a member of the CPU shader
@@ -93,7 +100,7 @@ set(AIRLIGHT_SCENE_MEMBER_LIST "")
 set(AIRLIGHT_QUALITY_BASES "")
 set(AIRLIGHT_QUALITY_KEY_EFFECTS "")
 set(AIRLIGHT_QUALITY_KEYS "")
-set(AIRLIGHT_HOOK_KINDS surface_irradiance escaping_radiance emitter_hit view_transfer view_glow pixel_cores)
+set(AIRLIGHT_HOOK_KINDS surface_irradiance escaping_radiance emitter_hit view_transfer view_glow pixel_cores backplate)
 foreach(kind IN LISTS AIRLIGHT_HOOK_KINDS)
   set(AIRLIGHT_HOOKS_${kind} "")
 endforeach()
@@ -306,7 +313,12 @@ function(airlight_write_registry output)
   foreach(f IN LISTS AIRLIGHT_HOOKS_pixel_cores)
     string(APPEND hooks "    radiance = ${f}(x, row, radiance);\n")
   endforeach()
-  string(APPEND hooks "    return radiance;\n}\n")
+  string(APPEND hooks "    return radiance;\n}\n\n")
+  string(APPEND hooks "bool hooks_backplate(int x, int row, INOUT(vec3) dir, INOUT(float) t_end, INOUT(vec3) radiance) {\n")
+  foreach(f IN LISTS AIRLIGHT_HOOKS_backplate)
+    string(APPEND hooks "    if (${f}(x, row, dir, t_end, radiance)) return true;\n")
+  endforeach()
+  string(APPEND hooks "    return false;\n}\n")
   file(WRITE ${dir}/airlight_hooks.glsl.tmp "${hooks}")
   file(COPY_FILE ${dir}/airlight_hooks.glsl.tmp ${dir}/airlight_hooks.glsl ONLY_IF_DIFFERENT)
   # Compilation order: the registry's constants, the core's formulas, every

@@ -5,6 +5,7 @@
 #include <pybind11/pybind11.h>
 #include <pybind11/stl.h>
 
+#include <array>
 #include <atomic>
 #include <chrono>
 #include <cstring>
@@ -731,29 +732,50 @@ PYBIND11_MODULE(_core, m) {
              })
         // The named render outputs (airlight.render_outputs: names checked by the
         // caller), each a float32 array (height, width[, 3]), computed in one pass.
-        .def("render_outputs", [](airlight::Renderer& r, py::handle scene_obj, const std::vector<std::string>& names) {
-            const Scene scene = scene_from_python(scene_obj);
-            bool extra = false;
-            for (const std::string& name : names) extra = extra || name != "radiance";
-            const airlight::Image image = render_interruptibly(r, scene, extra);
-            py::dict result;
-            for (const std::string& name : names) {
-                int components = 3;
-                for (const airlight::RenderOutput& o : airlight::render_outputs())
-                    if (o.name == name) components = o.components;
-                std::vector<float> values;
-                try {
-                    values = airlight::output_values(image, name);
-                } catch (const std::invalid_argument& e) {
-                    throw py::value_error(std::string("outputs: ") + e.what());
+        // With `backplate` (float32 (height, width, 4): linear RGB and depth, the
+        // film's size; airlight.photo), it ends each camera ray (effects/photo).
+        .def(
+            "render_outputs",
+            [](airlight::Renderer& r, py::handle scene_obj, const std::vector<std::string>& names,
+               std::optional<py::array_t<float, py::array::c_style | py::array::forcecast>> backplate,
+               bool depth_along_axis, std::optional<std::array<float, 4>> intrinsics) {
+                Scene scene = scene_from_python(scene_obj);
+                if (backplate) {
+                    const py::array_t<float, py::array::c_style | py::array::forcecast>& b = *backplate;
+                    if (b.ndim() != 3 || b.shape(0) != scene.film.height || b.shape(1) != scene.film.width ||
+                        b.shape(2) != 4)
+                        throw py::value_error("backplate: expected shape (" + std::to_string(scene.film.height) + ", " +
+                                              std::to_string(scene.film.width) + ", 4)");
+                    scene.backplate.rgbd = std::make_shared<const std::vector<float>>(b.data(), b.data() + b.size());
+                    scene.backplate.width = scene.film.width;
+                    scene.backplate.height = scene.film.height;
+                    scene.backplate.depth_along_axis = depth_along_axis;
+                    if (intrinsics)
+                        for (int k = 0; k < 4; ++k) scene.backplate.intrinsics[k] = (*intrinsics)[size_t(k)];
                 }
-                py::array_t<float> a(components == 1 ? std::vector<py::ssize_t>{image.height, image.width}
-                                                     : std::vector<py::ssize_t>{image.height, image.width, 3});
-                std::copy(values.begin(), values.end(), a.mutable_data());
-                result[py::str(name)] = a;
-            }
-            return result;
-        });
+                bool extra = false;
+                for (const std::string& name : names) extra = extra || name != "radiance";
+                const airlight::Image image = render_interruptibly(r, scene, extra);
+                py::dict result;
+                for (const std::string& name : names) {
+                    int components = 3;
+                    for (const airlight::RenderOutput& o : airlight::render_outputs())
+                        if (o.name == name) components = o.components;
+                    std::vector<float> values;
+                    try {
+                        values = airlight::output_values(image, name);
+                    } catch (const std::invalid_argument& e) {
+                        throw py::value_error(std::string("outputs: ") + e.what());
+                    }
+                    py::array_t<float> a(components == 1 ? std::vector<py::ssize_t>{image.height, image.width}
+                                                         : std::vector<py::ssize_t>{image.height, image.width, 3});
+                    std::copy(values.begin(), values.end(), a.mutable_data());
+                    result[py::str(name)] = a;
+                }
+                return result;
+            },
+            py::arg("scene"), py::arg("names"), py::arg("backplate") = py::none(), py::arg("depth_along_axis") = false,
+            py::arg("intrinsics") = py::none());
     m.def("render_outputs", [] {
         py::list list;
         for (const airlight::RenderOutput& o : airlight::render_outputs()) {

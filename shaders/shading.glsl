@@ -5,6 +5,22 @@
 // are compile-time constants in a GL shader variant and cheap runtime flags
 // on the CPU.
 
+// Light `radiance` leaving the end of the ray origin + t dir at t_hit (NO_HIT:
+// it escapes), on a surface of unit normal n facing the camera (vec3(0): none),
+// as it reaches the camera: everything behind the homogeneous medium reaches
+// the camera attenuated; then the effects' media along the ray (view_transfer:
+// attenuation and in-scattering; view_glow: the lamps' light scattered toward
+// the camera). The render outputs (outputs.glsl): where the ray ends, and this
+// light as the first layer, attenuated with it.
+vec3 view_ray(vec3 origin, vec3 dir, float t_hit, vec3 n, vec3 radiance) {
+    outputs_ray_end(dir, t_hit, n);
+    layer_add(LAYER_SURFACES, radiance);
+    vec3 through_medium = transmittance(t_hit);
+    outputs_attenuate(through_medium);
+    radiance *= through_medium;
+    return hooks_view_segment(origin, dir, t_hit, radiance);
+}
+
 // Radiance arriving at the camera along the ray origin + t dir (lamp cores
 // smaller than a pixel excepted: hooks_pixel_cores).
 vec3 ray_radiance(vec3 origin, vec3 dir) {
@@ -31,17 +47,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     } else {
         radiance = vec3(frame.background) + hooks_escaping_radiance(dir);
     }
-    // Everything behind the homogeneous medium reaches the camera attenuated;
-    // then the effects' media along the ray (view_transfer: attenuation and
-    // in-scattering; view_glow: the lamps' light scattered toward the camera).
-    // The render outputs (outputs.glsl): where the ray ends, and this light as
-    // the first layer, attenuated with it.
-    outputs_ray_end(dir, t_hit, hit_index >= 0 && !emitter ? normal : vec3(0.0f));
-    layer_add(LAYER_SURFACES, radiance);
-    vec3 through_medium = transmittance(t_hit);
-    outputs_attenuate(through_medium);
-    radiance *= through_medium;
-    return hooks_view_segment(origin, dir, t_hit, radiance);
+    return view_ray(origin, dir, t_hit, hit_index >= 0 && !emitter ? normal : vec3(0.0f), radiance);
 }
 
 // The smallest normal float32 (FLT_MIN): below it a float is subnormal (denormal).
@@ -60,8 +66,19 @@ float flush_subnormal(float v) { return abs(v) < RADIANCE_MIN_NORMAL ? 0.0f : v;
 // with RENDER_OUTPUTS, its render outputs in pixel_outputs (outputs.glsl).
 vec3 render_pixel(int x, int row) {
     outputs_begin();
-    vec3 radiance = ray_radiance(vec3(frame.camera_position), camera_ray_direction(x, row));
-    radiance = hooks_pixel_cores(x, row, radiance);
+    vec3 origin = vec3(frame.camera_position);
+    vec3 dir = camera_ray_direction(x, row);
+    float t_end = NO_HIT;
+    vec3 at_end = vec3(0.0f);
+    vec3 radiance;
+    if (hooks_backplate(x, row, dir, t_end, at_end)) {
+        // An image ends the ray (a photo and its depth): it already shows
+        // whatever surfaces, emitters and cores the pixel sees.
+        radiance = view_ray(origin, dir, t_end, vec3(0.0f), at_end);
+    } else {
+        radiance = ray_radiance(origin, dir);
+        radiance = hooks_pixel_cores(x, row, radiance);
+    }
     radiance = vec3(flush_subnormal(radiance.r), flush_subnormal(radiance.g), flush_subnormal(radiance.b));
     // Saturated at the largest float, never Inf: the scene keys' bounds
     // (max_radiometric, max_extinction in cpp/scene_keys.hpp) keep valid scenes

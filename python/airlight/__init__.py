@@ -22,11 +22,13 @@ modules that hold them are private (their layout may change):
 - ``_image_io``: PNG, PFM and OpenEXR files;
 - ``_lights``: light helpers (headlights);
 - ``_rainbow``: the raindrops' phase function for sunlight;
+- ``photo`` (public): weather on a photograph with its depth (``airlight.photo.apply_weather``);
 - ``_checks``: the argument checks they share;
 - ``_core``: the native module (cpp/python_module.cpp).
 """
 
 from . import _core as _core
+from . import photo as photo
 from ._display import (
     TONEMAPS,
     auto_exposure,
@@ -74,6 +76,7 @@ __all__ = [
     "load_exr",
     "load_pfm",
     "load_scene",
+    "photo",
     "preset",
     "preset_names",
     "rainbow_phase",
