@@ -228,3 +228,10 @@ def test_the_readme_sweep_is_the_example_file_and_expands_to_27_items() -> None:
     assert len(items) == 27
     for it in items:
         airlight.load_scene(it.scene)  # every item valid
+
+
+def test_film_width_alone_keeps_each_scene_aspect_ratio() -> None:
+    items = batch.expand({**sweep(), "scenes": [NIGHT, "day_clear"], "film": {"width": 48}, "vary": {}})
+    assert [it.scene["film"] for it in items] == [{"width": 48, "height": 32}, {"width": 48, "height": 27}]
+    for it in items:
+        airlight.load_scene(it.scene)

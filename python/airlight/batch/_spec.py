@@ -18,7 +18,7 @@ from typing import Any, Union
 import numpy as np
 
 from .._rendering import LAYERS, OUTPUTS
-from .._scenes import preset, preset_names
+from .._scenes import _with_film_size, preset, preset_names
 
 SpecLike = Union[Mapping[str, Any], str, "os.PathLike[str]"]
 
@@ -343,9 +343,8 @@ def expand(spec: SpecLike | BatchSpec) -> list[BatchItem]:
             if cam is not None:
                 scene["camera"] = {**scene.get("camera", {}), **copy.deepcopy(cam)}
             if s.film is not None:
-                scene["film"] = {**scene.get("film", {}), **s.film}
-                if len(s.film) == 1:  # one side alone: the scene's aspect ratio (Renderer.render)
-                    scene["film"] = dict(s.film)
+                # One side alone keeps the scene's aspect ratio, as Renderer.render(width=...) does.
+                scene = _with_film_size(scene, s.film.get("width"), s.film.get("height"))
             for path, value in zip(grid_paths, values):
                 parameters[path] = copy.deepcopy(value)
             rng = np.random.default_rng([s.seed, index])
