@@ -253,5 +253,88 @@ def apply_weather(image: Any, depth: Any, camera: Any, weather: dict[str, Any] |
                           outputs=out)
 
 
+def _read_image(path: str) -> np.ndarray:
+    """An image file as apply_weather takes it: 8-bit sRGB (PNG, JPEG, ...) or linear float
+    (the radiance of an EXR, a .npy array)."""
+    if path.lower().endswith(".exr"):
+        return load_exr(path)["radiance"]
+    if path.lower().endswith(".npy"):
+        return np.asarray(np.load(path))
+    from PIL import Image
+
+    with Image.open(path) as im:
+        return np.asarray(im.convert("RGB"))
+
+
+def _read_json(path: str | None, what: str) -> Any:
+    if path is None:
+        return None
+    import json
+
+    try:
+        with open(path) as f:
+            return json.load(f)
+    except OSError as e:
+        raise ValueError(f"{what}: cannot read {path}: {e.strerror}") from None
+    except json.JSONDecodeError as e:
+        raise ValueError(f"{what}: {path}: invalid JSON at line {e.lineno}, column {e.colno}: "
+                         f"{e.msg}") from None
+
+
+def main(argv: list[str] | None = None) -> int:
+    """``airlight-photo IMAGE DEPTH --out OUT``: the command-line form of
+    :func:`apply_weather`. OUT.png: the weathered image, displayed; OUT.exr: its linear
+    radiance with the transmittance, the in-scattered light and the layers as channels.
+    Exit status 2 and one line on stderr for bad input."""
+    import argparse
+    import sys
+
+    ap = argparse.ArgumentParser(prog="airlight-photo", description=main.__doc__)
+    ap.add_argument("image", help="the photo: 8-bit sRGB (PNG, JPEG) or linear float (EXR, NPY)")
+    ap.add_argument("depth", help="its depth map (see --depth-encoding)")
+    ap.add_argument("--out", required=True, help="OUT.png (displayed) or OUT.exr (linear, with the maps)")
+    cam = ap.add_mutually_exclusive_group(required=True)
+    cam.add_argument("--fov", type=float, help="vertical field of view, degrees")
+    cam.add_argument("--intrinsics", help="fx,fy,cx,cy in pixels")
+    ap.add_argument("--depth-encoding", default="png16", choices=DEPTH_ENCODINGS)
+    ap.add_argument("--depth-scale", type=float, default=1.0 / 256.0, help="metres per unit of a 16-bit PNG")
+    ap.add_argument("--depth-kind", default="ray", choices=DEPTH_KINDS)
+    ap.add_argument("--weather", help="a JSON file of the scene's weather objects (WEATHER_KEYS)")
+    ap.add_argument("--lights", help="a JSON file: a list of the scene's lights, in the camera's frame")
+    ap.add_argument("--exposure", type=float, default=1.0, help="for the PNG")
+    ap.add_argument("--backend", default="auto", choices=("auto", "gl", "cpu"))
+    args = ap.parse_args(argv)
+    try:
+        if not args.out.lower().endswith((".png", ".exr")):
+            raise ValueError(f"--out: must end in .png or .exr, got {args.out!r}")
+        camera: Any = args.fov
+        if args.intrinsics is not None:
+            try:
+                fx, fy, cx, cy = (float(v) for v in args.intrinsics.split(","))
+            except ValueError:
+                raise ValueError(f"--intrinsics: expected fx,fy,cx,cy, got {args.intrinsics!r}") from None
+            camera = [[fx, 0.0, cx], [0.0, fy, cy], [0.0, 0.0, 1.0]]
+        image = _read_image(args.image)
+        depth = read_depth(args.depth, args.depth_encoding, scale=args.depth_scale)
+        out = apply_weather(image, depth, camera, _read_json(args.weather, "--weather"),
+                            _read_json(args.lights, "--lights"), depth_kind=args.depth_kind,
+                            backend=args.backend, exposure=args.exposure)
+        if args.out.lower().endswith(".png"):
+            from PIL import Image
+
+            Image.fromarray(out.display, mode="RGB").save(args.out, format="PNG")
+        else:
+            from ._image_io import save_exr
+
+            save_exr(args.out, {"radiance": out.linear, "transmittance": out.transmittance,
+                                "inscattered": out.inscattered,
+                                **{n: out.outputs[n] for n in LAYERS}})
+    except (TypeError, ValueError, OSError) as e:
+        print(f"airlight-photo: {e}", file=sys.stderr)
+        return 2
+    print(f"airlight-photo: {args.out} {out.linear.shape[1]}x{out.linear.shape[0]}")
+    return 0
+
+
 __all__ = ["DEPTH_ENCODINGS", "DEPTH_KINDS", "WEATHER_KEYS", "WeatheredImage", "apply_weather", "read_depth",
            "save_depth_png16", "srgb8_to_linear", "weather_scene"]

@@ -175,3 +175,47 @@ def test_depth_readers_round_trip(tmp_path):
     np.testing.assert_array_equal(photo.read_depth(tmp_path / "d.npy", "npy", invalid=None), depth)
     airlight.save_exr(tmp_path / "d.exr", {"depth": depth, "radiance": np.zeros((5, 7, 3), np.float32)})
     np.testing.assert_array_equal(photo.read_depth(tmp_path / "d.exr", "exr", invalid=None), depth)
+
+
+# ---- the command-line form ---------------------------------------------------------------
+
+def test_command_line_equals_apply_weather(tmp_path) -> None:
+    import json
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[3] / "examples" / "photo"
+    weather = {"medium": {"visibility": 80.0, "albedo": 0.9}, "atmospheric_light": [0.05, 0.05, 0.06]}
+    (tmp_path / "w.json").write_text(json.dumps(weather))
+    proc = subprocess.run([str(Path(sys.executable).with_name("airlight-photo")), str(example / "street.png"),
+                           str(example / "street_depth.png"), "--depth-encoding", "kitti", "--fov", "60",
+                           "--weather", str(tmp_path / "w.json"), "--backend", "cpu",
+                           "--out", str(tmp_path / "out.exr")], capture_output=True, text=True, timeout=120)
+    assert proc.returncode == 0, proc.stderr
+    from PIL import Image
+
+    image = np.asarray(Image.open(example / "street.png").convert("RGB"))
+    depth = photo.read_depth(example / "street_depth.png", "kitti")
+    expected = photo.apply_weather(image, depth, 60.0, weather, backend="cpu")
+    written = airlight.load_exr(tmp_path / "out.exr")
+    np.testing.assert_array_equal(written["radiance"], expected.linear)
+    np.testing.assert_array_equal(written["transmittance"], expected.transmittance)
+
+
+@pytest.mark.parametrize("args, message", [
+    (["--fov", "60", "--out", "x.tif"], "--out: must end in .png or .exr"),
+    (["--intrinsics", "1,2,3", "--out", "x.png"], "--intrinsics: expected fx,fy,cx,cy"),
+    (["--fov", "60", "--weather", "missing.json", "--out", "x.png"], "--weather: cannot read missing.json"),
+])
+def test_command_line_bad_input_exits_2_with_one_line(tmp_path, args, message) -> None:
+    import subprocess
+    import sys
+    from pathlib import Path
+
+    example = Path(__file__).resolve().parents[3] / "examples" / "photo"
+    proc = subprocess.run([str(Path(sys.executable).with_name("airlight-photo")), str(example / "street.png"),
+                           str(example / "street_depth.png"), *args], capture_output=True, text=True,
+                          timeout=120, cwd=tmp_path)
+    assert proc.returncode == 2
+    assert len(proc.stderr.splitlines()) == 1 and message in proc.stderr, proc.stderr
