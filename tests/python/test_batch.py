@@ -235,3 +235,9 @@ def test_film_width_alone_keeps_each_scene_aspect_ratio() -> None:
     assert [it.scene["film"] for it in items] == [{"width": 48, "height": 32}, {"width": 48, "height": 27}]
     for it in items:
         airlight.load_scene(it.scene)
+
+
+@pytest.mark.parametrize("path", ["", "a..b", "a[x]", "[0]", "a.", "a[0", 3])
+def test_bad_key_paths_are_refused(path) -> None:
+    with pytest.raises(ValueError, match="vary: bad key path"):
+        batch.key_path(path)

@@ -97,25 +97,17 @@ def _read(spec: SpecLike) -> tuple[dict[str, Any], Path | None]:
     return data, path.parent
 
 
+# A key path: a key, then ".key", ".index" or "[index]" parts.
+_KEY_PATH = re.compile(r"[^.\[\]]+(?:\.[^.\[\]]+|\[\d+\])*")
 _PATH_PART = re.compile(r"([^.\[\]]+)|\[(\d+)\]")
 
 
 def key_path(path: str) -> list[str | int]:
     """``"lights[0].intensity"`` or ``"lights.0.intensity"`` -> ``["lights", 0, "intensity"]``."""
-    if not isinstance(path, str) or not path:
-        raise ValueError(f"vary: a key path must be a non-empty string, got {path!r}")
-    parts: list[str | int] = []
-    for name, index in _PATH_PART.findall(path):
-        if index:
-            parts.append(int(index))
-        elif name.isdigit():
-            parts.append(int(name))
-        else:
-            parts.append(name)
-    if "".join(f"[{p}]" if isinstance(p, int) else p for p in parts).replace("]", "").replace("[", "") != \
-            path.replace(".", "").replace("[", "").replace("]", ""):
-        raise ValueError(f"vary: bad key path {path!r}")
-    return parts
+    if not isinstance(path, str) or _KEY_PATH.fullmatch(path) is None:
+        raise ValueError(f"vary: bad key path {path!r} (keys joined by '.', list indices as .0 or [0])")
+    return [int(index) if index else int(name) if name.isdigit() else name
+            for name, index in _PATH_PART.findall(path)]
 
 
 def set_path(scene: dict[str, Any], path: str, value: Any) -> None:
