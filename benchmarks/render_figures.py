@@ -26,6 +26,9 @@
   side; rain_ends.png: the end of the heavy shower (airlight-demo --sequence
   rain-ends, 6 frames at 320x200): the sun comes out, the bow appears and
   fades with the drops.
+- light_shafts.png: the light shafts' presets (issue 20; scenes/shafts_*.json, 320 x 180 each):
+  each with shafts (left) and with ``quality.shafts`` "off" (right), one row per preset, each
+  shown with its scene's display settings.
 
 The first figures use the linear curve (``--tonemap linear``) with the
 exposures above, as before the display stage existed.
@@ -130,14 +133,34 @@ def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
         Image.fromarray(np.concatenate(tiles[:-1], axis=1)).save(sequence_out)
 
 
+def light_shafts_figure(backend: str, out: Path) -> None:
+    """Each light-shafts preset with and without shafts, a row each."""
+    rows = []
+    with airlight.Renderer(backend) as r:
+        for name in ("shafts_low_sun", "shafts_sun_behind", "shafts_rain_rainbow"):
+            tiles = []
+            for shafts in ("analytic", "off"):
+                scene = airlight.preset(name)
+                scene.setdefault("quality", {})["shafts"] = shafts
+                tiles.append(airlight.display_scene(r.render(scene, width=320, height=180), scene))
+                tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
+            rows.append(np.concatenate(tiles[:-1], axis=1))
+            rows.append(np.full((6, rows[-1].shape[1], 3), 255, np.uint8))
+    Image.fromarray(np.concatenate(rows[:-1], axis=0)).save(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
-    ap.add_argument("--only", choices=["rainbows", "daytime", "night"], help="render only these figures")
+    ap.add_argument("--only", choices=["rainbows", "daytime", "night", "shafts"],
+                    help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
     if args.only == "night":
         night_street_figures(args.backend)
+        return
+    if args.only == "shafts":
+        light_shafts_figure(args.backend, IMAGES / "light_shafts.png")
         return
     if args.only == "daytime":
         day_weather_strip(args.backend, IMAGES / "day_weather.png")
@@ -150,6 +173,7 @@ def main() -> None:
     approaching_car_strip(args.backend, IMAGES / "approaching_car.png")
     day_weather_strip(args.backend, IMAGES / "day_weather.png")
     heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
+    light_shafts_figure(args.backend, IMAGES / "light_shafts.png")
     with airlight.Renderer(args.backend) as r:
         tiles = []
         for density in ("000", "001", "002", "004"):

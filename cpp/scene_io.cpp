@@ -173,18 +173,19 @@ float read_light_radius(const SceneObject& o, const Rgb& intensity) {
 }
 
 PointLight parse_point_light(const SceneObject& o) {
-    o.check_keys({"type", "position", "intensity", "radius"});
+    o.check_keys({"type", "position", "intensity", "radius", "volumetric_shadows"});
     PointLight l;
     l.position = read_vec3(o.req("position"));
     l.intensity = read_rgb(o.req("intensity"));
     l.radius = read_light_radius(o, l.intensity);
+    if (auto v = o.opt("volumetric_shadows")) l.volumetric_shadows = read_bool(*v);
     return l;
 }
 
 // Spot light (effects/spotlights/physics.md): cone_angle is the half-angle in degrees,
 // in [min_cone_angle, 90] (checked on the float value too); edge in [0, 1].
 SpotLight parse_spot_light(const SceneObject& o) {
-    o.check_keys({"type", "position", "direction", "intensity", "cone_angle", "edge", "radius"});
+    o.check_keys({"type", "position", "direction", "intensity", "cone_angle", "edge", "radius", "volumetric_shadows"});
     SpotLight l;
     l.position = read_vec3(o.req("position"));
     l.direction = read_direction(o.req("direction"), "must not be zero");
@@ -201,6 +202,7 @@ SpotLight parse_spot_light(const SceneObject& o) {
         l.edge = static_cast<float>(edge);
     }
     l.radius = read_light_radius(o, l.intensity);
+    if (auto v = o.opt("volumetric_shadows")) l.volumetric_shadows = read_bool(*v);
     return l;
 }
 
@@ -325,7 +327,8 @@ json scene_to_json_value(const Scene& s) {
         j["lights"].push_back({{"type", name_of(light_types, LightType::point)},
                                {"position", json_vec3(l.position)},
                                {"intensity", json_vec3(l.intensity)},
-                               {"radius", json_number(l.radius)}});
+                               {"radius", json_number(l.radius)},
+                               {"volumetric_shadows", l.volumetric_shadows}});
     }
     for (const auto& l : s.spot_lights) {
         j["lights"].push_back({{"type", name_of(light_types, LightType::spot)},
@@ -334,7 +337,8 @@ json scene_to_json_value(const Scene& s) {
                                {"intensity", json_vec3(l.intensity)},
                                {"cone_angle", json_number(l.cone_angle_degrees)},
                                {"edge", json_number(l.edge)},
-                               {"radius", json_number(l.radius)}});
+                               {"radius", json_number(l.radius)},
+                               {"volumetric_shadows", l.volumetric_shadows}});
     }
     j["surfaces"] = json::array();
     for (const auto& sf : s.surfaces) {

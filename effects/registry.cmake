@@ -3,6 +3,7 @@
 # features, tables and frame data are declared. Adding an effect: create its
 # folder with an effect.cmake (cmake/effects.cmake says what it sets), then add
 # its line here.
+airlight_effect(light_shafts)
 airlight_effect(lamp_airlight)
 airlight_effect(phase)
 airlight_effect(spotlights)

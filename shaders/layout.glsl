@@ -14,7 +14,7 @@ CONST int BINDING_OUTPUTS = 5;       // storage block written by the shading pas
 // radiant intensity I (W/sr), hence radiance I / (pi r^2) on its disc.
 struct PointLightGpu {
     vec4 position_radius;  // xyz: centre, w: radius (m)
-    vec4 intensity;        // rgb: W/sr
+    vec4 intensity;        // rgb: W/sr, w: 1 with volumetric shadows (effects/light_shafts/physics.md section 7)
 };
 
 // A spotlight (effects/spotlights/physics.md): profile I(theta) = I0 [(1 - q)(cos theta -
@@ -27,7 +27,7 @@ struct SpotLightGpu {
     vec4 world_position;            // xyz: S
     vec4 axis_cos;                  // xyz: unit axis a, w: cos A
     vec4 intensity_edge;            // rgb: I0 (W/sr on the axis), w: edge softness q
-    vec4 cone;                      // x: sin^2 A, y: 1 - cos A, z: beta = (1 - q) / (1 - cos A)
+    vec4 cone;                      // x: sin^2 A, y: 1 - cos A, z: beta = (1 - q) / (1 - cos A), w: 1 with volumetric shadows
 };
 
 // A Lambertian surface. type (albedo_type.w, exact small integer):

@@ -31,21 +31,28 @@ vec3 sky_escaping_radiance(vec3 dir) {
 }
 
 // Hook view_transfer: aerial perspective on whatever the ray ends at, plus the
-// sky and sun light the atmosphere's particles scatter toward the camera.
+// sky and sun light the atmosphere's particles scatter toward the camera (and
+// the homogeneous medium's sunlight, which varies with the atmosphere's
+// transmittance to each altitude), the sun's over the lit parts of the ray.
 vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_ATMOSPHERE) return radiance;
     vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
     vec3 inscatter;
     vec3 rainbow;  // the rain's sunlight, kept apart only for the render outputs (rainbow_layer_apart)
+    vec3 medium_sun;  // the homogeneous medium's sunlight (HAS_MEDIUM_SUN; effects/light_shafts)
     vec3 through_atmosphere;
     if (SKY_MARCH) {
         atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter, rainbow,
-                                    through_atmosphere);
+                                    medium_sun, through_atmosphere);
     } else {
-        atmosphere_scattering(origin, dir, t_hit, sigma_medium, inscatter, rainbow, through_atmosphere);
+        // The sun's shadows along the ray (effects/light_shafts): counted by the volumes.
+        sun_shadow_runs(origin, dir, t_hit);
+        atmosphere_scattering(origin, dir, t_hit, sigma_medium, true, inscatter, rainbow, medium_sun,
+                              through_atmosphere);
     }
     outputs_attenuate(through_atmosphere);
     layer_add(LAYER_SKY, inscatter);
     layer_add(LAYER_RAINBOW, rainbow);
-    return radiance * through_atmosphere + inscatter + rainbow;
+    layer_add(LAYER_MEDIUM_SUN, medium_sun);
+    return radiance * through_atmosphere + inscatter + rainbow + medium_sun;
 }

@@ -142,16 +142,21 @@ vec3 sun_irradiance(vec3 p, vec3 n) {
 // With multiple scattering (HAS_MULTIPLE_SCATTERING), a third part: the light
 // scattered at least once before, K_i(y, d) + E_res(y) p_i(d . s)
 // (effects/multiple_scattering/ms_field.glsl).
+// medium_sun: the sun's light on the homogeneous medium through its phase
+// function (with HAS_MEDIUM_SUN; effects/light_shafts/physics.md section 3).
 struct SpeciesLight {
     vec3 sky[3];
     vec3 sun[3];
     vec3 ms[3];
+    vec3 medium_sun;
 };
 
 // Each species' phase function for the sun's light along a view ray, per
 // channel (only the rain's depends on wavelength: its rainbow).
+// `medium`: the homogeneous medium's (HAS_MEDIUM_SUN).
 struct SunPhase {
     vec3 species[SPECIES_COUNT];
+    float medium;
 };
 
 SunPhase sun_phase_along(vec3 d) {
@@ -159,6 +164,14 @@ SunPhase sun_phase_along(vec3 d) {
     float cos_sun = dot(d, vec3(frame.sky.sun_direction));
     for (int i = 0; i < 3; ++i) p.species[i] = vec3(species_phase(frame.species[i].phase, cos_sun));
     if (HAS_RAINBOW) p.species[SPECIES_RAIN] = rainbow_phase(cos_sun);
+    p.medium = HAS_MEDIUM_SUN ? medium_phase_between(vec3(frame.sky.sun_direction), d) / (4.0f * PI) : 0.0f;
+    return p;
+}
+
+SunPhase no_sun_phase() {
+    SunPhase p;
+    for (int i = 0; i < 3; ++i) p.species[i] = vec3(0.0f);
+    p.medium = 0.0f;
     return p;
 }
 
@@ -181,6 +194,7 @@ SpeciesLight species_light(SkyTableDirection t, MsDirection ms_dir, float y, vec
     out_light.sun[0] = sun * sun_phase.species[SPECIES_MOLECULES];
     out_light.sun[1] = sun * sun_phase.species[SPECIES_AEROSOL];
     out_light.sun[2] = sun * sun_phase.species[SPECIES_RAIN];
+    out_light.medium_sun = sun * sun_phase.medium;
     for (int i = 0; i < 3; ++i) out_light.ms[i] = vec3(0.0f);
     if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
         MsLevel level = ms_level(y);
@@ -366,6 +380,49 @@ vec3 source_integral3(vec3 dtau, vec3 s_a, vec3 s_b) {
                 source_integral(dtau.z, s_a.z, s_b.z));
 }
 
+// int_{t0}^{t1} e^{-t} S(t) dt over part [t0, t1] of a volume of optical
+// depth dtau whose source S is exponential in optical depth from s_a at 0 to
+// s_b at dtau (source_integral's model; its ends at t0 and t1 interpolated
+// geometrically): e^{-t0} times source_integral of the part. The whole volume
+// gives source_integral itself, so a ray no shadow reaches is unchanged.
+float source_integral_part(float dtau, float s_a, float s_b, float t0, float t1) {
+    if (t0 == 0.0f && t1 == dtau) return source_integral(dtau, s_a, s_b);
+    float floor_value = 1.0e-30f * max(s_a, s_b);
+    if (!(floor_value > 0.0f) || !(t1 > t0)) return 0.0f;
+    s_a = max(s_a, floor_value);
+    s_b = max(s_b, floor_value);
+    float r = log(s_b / s_a);
+    float f0 = dtau > 0.0f ? clamp(t0 / dtau, 0.0f, 1.0f) : 0.0f;
+    float f1 = dtau > 0.0f ? clamp(t1 / dtau, 0.0f, 1.0f) : 0.0f;
+    return exp(-t0) * source_integral(t1 - t0, s_a * exp(r * f0), s_a * exp(r * f1));
+}
+
+vec3 source_integral_part3(vec3 dtau, vec3 s_a, vec3 s_b, vec3 t0, vec3 t1) {
+    return vec3(source_integral_part(dtau.x, s_a.x, s_b.x, t0.x, t1.x),
+                source_integral_part(dtau.y, s_a.y, s_b.y, t0.y, t1.y),
+                source_integral_part(dtau.z, s_a.z, s_b.z, t0.z, t1.z));
+}
+
+// The sun's light of a lit part [t0, t1] (optical depth from the volume's
+// start, per channel) of a volume: each species' share (sun_a, sun_b: its
+// source functions at the volume's ends) into inscatter or, for the rain kept
+// apart, rainbow; the homogeneous medium's (index SPECIES_COUNT) into
+// medium_sun; `weight`: the transmittance from the camera to the volume.
+void add_sun_part(vec3 weight, vec3 dtau, vec3 t0, vec3 t1, vec3 sun_a[SPECIES_COUNT + 1],
+                  vec3 sun_b[SPECIES_COUNT + 1], INOUT(vec3) inscatter, INOUT(vec3) rainbow,
+                  INOUT(vec3) medium_sun) {
+    for (int i = 0; i < 3; ++i) {
+        if (!species_present(i)) continue;
+        vec3 part = weight * source_integral_part3(dtau, sun_a[i], sun_b[i], t0, t1);
+        if (rainbow_layer_apart(i)) {
+            rainbow += part;
+        } else {
+            inscatter += part;
+        }
+    }
+    if (HAS_MEDIUM_SUN) medium_sun += weight * source_integral_part3(dtau, sun_a[SPECIES_COUNT], sun_b[SPECIES_COUNT], t0, t1);
+}
+
 // The source function J / sigma (0 where sigma = 0).
 vec3 source_function(vec3 j, vec3 sigma) {
     return vec3(sigma.x > 0.0f ? j.x / sigma.x : 0.0f, sigma.y > 0.0f ? j.y / sigma.y : 0.0f,
@@ -384,20 +441,26 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // function J / sigma_t are taken exponential in optical depth between its
 // ends, integrated exactly against e^{-tau} (source_integral; the seed's
 // constant-source form is the case r = 0). sigma_medium: the
-// homogeneous medium's extinction, which attenuates but scatters no sky light.
-void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(vec3) inscatter,
-                           OUT(vec3) rainbow, OUT(vec3) transmittance) {
+// homogeneous medium's extinction, which attenuates and (HAS_MEDIUM_SUN)
+// scatters the sun's light into `medium_sun`, but no sky light. The sun's
+// shares count only over the lit parts of each volume, the complement of the
+// shadowed runs (`shadowed`: those of shadow_runs, effects/light_shafts/physics.md
+// section 5; false: none).
+void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, OUT(vec3) inscatter,
+                           OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
     rainbow = vec3(0.0f);
+    medium_sun = vec3(0.0f);
     transmittance = vec3(1.0f);
     float s_in;
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
     SkyTableDirection t = sky_table_direction(d);
     MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
-    SunPhase sun_phase;
-    for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
+    SunPhase sun_phase = no_sun_phase();
     if (HAS_SUN) sun_phase = sun_phase_along(d);
+    int run_index = 0;  // the first shadowed run that may reach the volume
+    int run_count = shadowed ? shadow_runs.count : 0;
     float mu = d.y;
     float y_a = o.y + mu * s_in;
     if (mu != 0.0f) y_a = clamp(y_a, 0.0f, frame.atmosphere.top);
@@ -433,6 +496,13 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
             sigma_a += vec3(frame.species[i].sigma_t) * piece_density(frame.species[i], piece, y_a);
             sigma_b += vec3(frame.species[i].sigma_t) * piece_density(frame.species[i], piece, y_b);
         }
+        // The sun's source functions at the ends: each species', then the medium's.
+        vec3 sun_a[SPECIES_COUNT + 1];
+        vec3 sun_b[SPECIES_COUNT + 1];
+        for (int i = 0; i < SPECIES_COUNT + 1; ++i) {
+            sun_a[i] = vec3(0.0f);
+            sun_b[i] = vec3(0.0f);
+        }
         for (int i = 0; i < 3; ++i) {
             if (!species_present(i)) continue;
             SpeciesGpu sp = frame.species[i];
@@ -442,18 +512,40 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, OUT(v
             inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sky[i], sigma_a),
                                                    source_function(scale_b * light_b.sky[i], sigma_b));
             if (HAS_SUN) {
-                vec3 sun_part = weight * source_integral3(dtau, source_function(scale_a * light_a.sun[i], sigma_a),
-                                                          source_function(scale_b * light_b.sun[i], sigma_b));
-                if (rainbow_layer_apart(i)) {
-                    rainbow += sun_part;
-                } else {
-                    inscatter += sun_part;
-                }
+                sun_a[i] = source_function(scale_a * light_a.sun[i], sigma_a);
+                sun_b[i] = source_function(scale_b * light_b.sun[i], sigma_b);
             }
             if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
                 inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.ms[i], sigma_a),
                                                        source_function(scale_b * light_b.ms[i], sigma_b));
             }
+        }
+        if (HAS_MEDIUM_SUN) {
+            sun_a[SPECIES_COUNT] = source_function(vec3(frame.sigma_s) * light_a.medium_sun, sigma_a);
+            sun_b[SPECIES_COUNT] = source_function(vec3(frame.sigma_s) * light_b.medium_sun, sigma_b);
+        }
+        if (HAS_SUN) {
+            // The lit parts [t0, t1] of the volume in optical depth from s_a
+            // (all of it, [0, dtau], where no shadowed run reaches it).
+            float lit_from = s_a;
+            vec3 tau_from = vec3(0.0f);
+            while (run_index < run_count && shadow_runs.run[run_index].x < s_b) {
+                vec2 run = shadow_runs.run[run_index];
+                if (run.x > lit_from) {
+                    vec3 tau_to = stretch_optical_depth(y_a, y_piece, mu, run.x - s_a) + sigma_medium * (run.x - s_a);
+                    add_sun_part(weight, dtau, tau_from, tau_to, sun_a, sun_b, inscatter, rainbow, medium_sun);
+                }
+                if (run.y >= s_b) {  // shadowed to the volume's end: the run may reach the next volume
+                    lit_from = s_b;
+                    break;
+                }
+                if (run.y > lit_from) {
+                    lit_from = run.y;
+                    tau_from = stretch_optical_depth(y_a, y_piece, mu, run.y - s_a) + sigma_medium * (run.y - s_a);
+                }
+                ++run_index;
+            }
+            if (lit_from < s_b) add_sun_part(weight, dtau, tau_from, dtau, sun_a, sun_b, inscatter, rainbow, medium_sun);
         }
         weight *= exp(-dtau);
         transmittance *= exp(-tau);
@@ -469,8 +561,9 @@ vec3 atmosphere_transmittance(vec3 o, vec3 d, float s_end) {
     if (!HAS_ATMOSPHERE) return vec3(1.0f);
     vec3 inscatter;
     vec3 rainbow;
+    vec3 medium_sun;
     vec3 t;
-    atmosphere_scattering(o, d, s_end, vec3(0.0f), inscatter, rainbow, t);
+    atmosphere_scattering(o, d, s_end, vec3(0.0f), false, inscatter, rainbow, medium_sun, t);
     return t;
 }
 
@@ -501,11 +594,14 @@ float march_far_distance(vec3 o, vec3 d, float s_in, float s_out, vec3 sigma_med
 
 // The same by brute force (benchmarks, SKY_MARCH): `steps` midpoint steps of
 // equal length over [s_in, s_far] (march_far_distance: rays end where they
-// have become opaque); transmittance accumulated step by step.
+// have become opaque); transmittance accumulated step by step; the sun's
+// light at each step only where a shadow ray finds it (HAS_SHAFTS).
 void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium, int steps,
-                                 OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) transmittance) {
+                                 OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun,
+                                 OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
     rainbow = vec3(0.0f);
+    medium_sun = vec3(0.0f);
     transmittance = vec3(1.0f);
     float s_in;
     float s_out;
@@ -513,8 +609,7 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     float s_far = march_far_distance(o, d, s_in, s_out, sigma_medium);
     SkyTableDirection t = sky_table_direction(d);
     MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
-    SunPhase sun_phase;
-    for (int i = 0; i < 3; ++i) sun_phase.species[i] = vec3(0.0f);
+    SunPhase sun_phase = no_sun_phase();
     if (HAS_SUN) sun_phase = sun_phase_along(d);
     float ds = (s_far - s_in) / float(steps);
     vec3 tau_medium = sigma_medium * s_in;
@@ -525,10 +620,16 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
         vec3 sigma;
         vec3 j;
         vec3 j_rainbow;
-        atmosphere_point(y, y, species_light(t, ms_dir, y, atmosphere_column(y), sun_phase), sigma, j, j_rainbow);
+        SpeciesLight light = species_light(t, ms_dir, y, atmosphere_column(y), sun_phase);
+        if (HAS_SUN && sun_visible_from_air(o + s * d) == 0.0f) {
+            for (int i = 0; i < 3; ++i) light.sun[i] = vec3(0.0f);
+            light.medium_sun = vec3(0.0f);
+        }
+        atmosphere_point(y, y, light, sigma, j, j_rainbow);
         vec3 reaching = exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds));
         inscatter += reaching * j * ds;
         rainbow += reaching * j_rainbow * ds;
+        if (HAS_MEDIUM_SUN) medium_sun += reaching * vec3(frame.sigma_s) * light.medium_sun * ds;
         tau += sigma * ds;
     }
     transmittance = exp(-tau);

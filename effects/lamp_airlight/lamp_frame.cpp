@@ -23,7 +23,8 @@ void pack_lamp_airlight_frame(const Scene& scene, FrameData& data) {
     std::stable_sort(lights.begin(), lights.end(),
                      [&](const PointLight& a, const PointLight& b) { return brightness(a) > brightness(b); });
     for (const PointLight& light : lights)
-        data.point_lights.push_back({glm::vec4(light.position, light.radius), glm::vec4(light.intensity, 0.0f)});
+        data.point_lights.push_back({glm::vec4(light.position, light.radius),
+                                     glm::vec4(light.intensity, light.volumetric_shadows ? 1.0f : 0.0f)});
     data.frame.point_light_count = int(data.point_lights.size());
 
     data.features.point_lights = !data.point_lights.empty();

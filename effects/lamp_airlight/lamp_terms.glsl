@@ -58,12 +58,30 @@ vec3 point_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     return irradiance;
 }
 
+// The airlight integral over the ray segment [x0, x1] of a lamp at closest
+// distance h (closest approach at b), times `scale` = sigma_s I / (2 pi h),
+// per channel: medium_airlight_segment (the segment integral of airlight.glsl,
+// per phase lobe), the scale folded into its exponent (airlight_tail);
+// channels without scattering or light have none.
+vec3 point_light_segment(vec3 scale, float b, float h, float x0, float x1) {
+    vec3 sigma_t = vec3(frame.sigma_t);
+    if (GREY_MEDIUM) {
+        float peak = max(max(scale.x, scale.y), scale.z);
+        return peak > 0.0f ? (scale / peak) * medium_airlight_segment(sigma_t.x, b, h, x0, x1, log(peak)) : vec3(0.0f);
+    }
+    return vec3(scale.x > 0.0f ? medium_airlight_segment(sigma_t.x, b, h, x0, x1, log(scale.x)) : 0.0f,
+                scale.y > 0.0f ? medium_airlight_segment(sigma_t.y, b, h, x0, x1, log(scale.y)) : 0.0f,
+                scale.z > 0.0f ? medium_airlight_segment(sigma_t.z, b, h, x0, x1, log(scale.z)) : 0.0f);
+}
+
 // Airlight of point light `light` over the visible part [0, x_end] of the
 // view ray (effects/lamp_airlight/physics.md): sigma_s I / (2 pi h) times the segment
 // integral of airlight.glsl. A camera inside the lamp's sphere sees fog from
 // where the ray leaves the sphere. Skipped when its bound
 // sigma_s I e^{-sigma_t (D - r)} (pi / 2) / (2 pi h) is negligible against
-// `so_far` (the pixel's radiance found so far).
+// `so_far` (the pixel's radiance found so far). A lamp with volumetric shadows
+// (intensity.w; HAS_LAMP_SHADOWS) sums the segment integral over the parts of
+// [x0, x_end] it lights (effects/light_shafts/physics.md section 7), exact.
 vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_end, vec3 so_far) {
     vec3 to_light = vec3(light.position_radius) - origin;
     float radius = light.position_radius.w;
@@ -73,19 +91,22 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     float x0 = 0.0f;
     if (dist < radius) x0 = b + sqrt(max(radius * radius - h * h, 0.0f));
     if (x0 >= x_end) return vec3(0.0f);
-    vec3 sigma_t = vec3(frame.sigma_t);
     vec3 scale = vec3(frame.sigma_s) * vec3(light.intensity) / (2.0f * PI * h);
     if (negligible(scale * frame.phase.airlight_bound * transmittance(max(dist - radius, 0.0f)), so_far)) return vec3(0.0f);
-    if (AIRLIGHT_MARCH) return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, origin, dir, x0, x_end);
-    // The scale goes into the exponent (airlight_tail); channels without
-    // scattering or light have none.
-    if (GREY_MEDIUM) {
-        float peak = max(max(scale.x, scale.y), scale.z);
-        return peak > 0.0f ? (scale / peak) * medium_airlight_segment(sigma_t.x, b, h, x0, x_end, log(peak)) : vec3(0.0f);
+    bool shadowed = HAS_LAMP_SHADOWS && light.intensity.w != 0.0f;
+    if (AIRLIGHT_MARCH)
+        return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, shadowed, origin, dir, x0, x_end);
+    if (!shadowed) return point_light_segment(scale, b, h, x0, x_end);
+    find_shadow_runs(origin, dir, x_end, vec4(vec3(light.position_radius), 1.0f));
+    vec3 airlight = vec3(0.0f);
+    float lit_from = x0;
+    for (int k = 0; k < shadow_runs.count; ++k) {
+        vec2 run = shadow_runs.run[k];
+        if (run.x > lit_from) airlight += point_light_segment(scale, b, h, lit_from, run.x);
+        lit_from = max(lit_from, run.y);
     }
-    return vec3(scale.x > 0.0f ? medium_airlight_segment(sigma_t.x, b, h, x0, x_end, log(scale.x)) : 0.0f,
-                scale.y > 0.0f ? medium_airlight_segment(sigma_t.y, b, h, x0, x_end, log(scale.y)) : 0.0f,
-                scale.z > 0.0f ? medium_airlight_segment(sigma_t.z, b, h, x0, x_end, log(scale.z)) : 0.0f);
+    if (lit_from < x_end) airlight += point_light_segment(scale, b, h, lit_from, x_end);
+    return airlight;
 }
 
 // Hook view_glow: the airlight of every point lamp over [0, t_hit], each

@@ -306,8 +306,10 @@ float spot_airlight_channel(SpotLightGpu s, SpotRay r, float sigma, float lo, fl
 // Brute-force airlight of a point light, or of spot number spot_index (>= 0),
 // on [x0, x1]: the midpoint rule with frame.march_steps steps on the defining
 // integral (effects/lamp_airlight/physics.md and effects/spotlights/physics.md), escaping rays cut at frame.march_far
-// metres. For benchmarks only.
-vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, vec3 origin, vec3 dir, float x0, float x1) {
+// metres; `shadowed`: a step counts only where a shadow ray reaches the lamp
+// (volumetric shadows, effects/light_shafts/physics.md section 7). For benchmarks only.
+vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, bool shadowed, vec3 origin, vec3 dir,
+                    float x0, float x1) {
     bool spot = spot_index >= 0;
     SpotLightGpu s;
     if (spot) s = spot_light(spot_index);
@@ -322,9 +324,28 @@ vec3 airlight_march(vec3 light_position, vec3 intensity, int spot_index, vec3 or
         float d2 = dot(from_light, from_light);
         float d = sqrt(d2);
         float profile = spot ? spot_profile_toward(s, from_light / d) : 1.0f;
+        if (shadowed && segment_occluded(origin + x * dir, -from_light / d, d, -1)) continue;
         sum += profile * medium_phase_between(from_light / d, -dir) * exp(-sigma_t * (x + d)) / d2;
     }
     return vec3(frame.sigma_s) * intensity * sum * (dx / (4.0f * PI));
+}
+
+// A spot's airlight over the part [lo, hi] (closest-point coordinates tau) of
+// the view ray inside its beam, per channel (spot_airlight_channel; wall_lo,
+// wall_hi: an end on the cone's wall; clip_length: hi - lo formed without
+// cancellation).
+vec3 spot_airlight_part(SpotLightGpu s, SpotRay r, vec3 scale, float lo, float hi, bool wall_lo, bool wall_hi,
+                        float clip_length) {
+    vec3 sigma_t = vec3(frame.sigma_t);
+    if (GREY_MEDIUM) {
+        float peak = max(max(scale.x, scale.y), scale.z);
+        if (!(peak > 0.0f)) return vec3(0.0f);
+        return (scale / peak) * spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, peak);
+    }
+    return vec3(
+        scale.x > 0.0f ? spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, scale.x) : 0.0f,
+        scale.y > 0.0f ? spot_airlight_channel(s, r, sigma_t.y, lo, hi, wall_lo, wall_hi, clip_length, scale.y) : 0.0f,
+        scale.z > 0.0f ? spot_airlight_channel(s, r, sigma_t.z, lo, hi, wall_lo, wall_hi, clip_length, scale.z) : 0.0f);
 }
 
 // Airlight of spot number spot_index over the visible part [0, x_end] of the view ray from
@@ -351,20 +372,34 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
     bool wall_hi;
     float tau_end = x_end >= NO_HIT ? NO_HIT : x_end - r.b;
     if (!spot_lit_interval(s, r, x0 - r.b, tau_end, lo, hi, wall_lo, wall_hi)) return vec3(0.0f);
+    bool shadowed = HAS_LAMP_SHADOWS && s.cone.w != 0.0f;
     if (AIRLIGHT_MARCH) {
-        return airlight_march(vec3(s.world_position), vec3(s.intensity_edge), spot_index, vec3(frame.camera_position),
-                              dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
+        return airlight_march(vec3(s.world_position), vec3(s.intensity_edge), spot_index, shadowed,
+                              vec3(frame.camera_position), dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
     }
-    float clip_length = x_end - x0;
-    if (GREY_MEDIUM) {
-        float peak = max(max(scale.x, scale.y), scale.z);
-        if (!(peak > 0.0f)) return vec3(0.0f);
-        return (scale / peak) * spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, peak);
+    if (!shadowed) return spot_airlight_part(s, r, scale, lo, hi, wall_lo, wall_hi, x_end - x0);
+    // Volumetric shadows: the beam's lit part [lo, hi] less the surfaces'
+    // shadows (effects/light_shafts/physics.md section 7); a part's end at a
+    // shadow's edge is no wall of the cone.
+    float x_hi = hi >= NO_HIT ? NO_HIT : hi + r.b;
+    find_shadow_runs(vec3(frame.camera_position), dir, x_hi, vec4(vec3(s.world_position), 1.0f));
+    vec3 airlight = vec3(0.0f);
+    float lit_from = lo + r.b;
+    bool wall_from = wall_lo;
+    for (int k = 0; k < shadow_runs.count; ++k) {
+        vec2 run = shadow_runs.run[k];
+        if (run.y <= lit_from) continue;
+        if (run.x > lit_from) {
+            airlight += spot_airlight_part(s, r, scale, lit_from - r.b, run.x - r.b, wall_from, false, run.x - lit_from);
+        }
+        lit_from = run.y;
+        wall_from = false;
     }
-    return vec3(
-        scale.x > 0.0f ? spot_airlight_channel(s, r, sigma_t.x, lo, hi, wall_lo, wall_hi, clip_length, scale.x) : 0.0f,
-        scale.y > 0.0f ? spot_airlight_channel(s, r, sigma_t.y, lo, hi, wall_lo, wall_hi, clip_length, scale.y) : 0.0f,
-        scale.z > 0.0f ? spot_airlight_channel(s, r, sigma_t.z, lo, hi, wall_lo, wall_hi, clip_length, scale.z) : 0.0f);
+    if (lit_from < x_hi) {
+        airlight += spot_airlight_part(s, r, scale, lit_from - r.b, hi, wall_from, wall_hi,
+                                       x_hi >= NO_HIT ? NO_HIT : x_hi - lit_from);
+    }
+    return airlight;
 }
 
 // spot_lit_interval for a receiver "spot" (cone angle 90 degrees: the half-

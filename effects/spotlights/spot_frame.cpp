@@ -24,7 +24,7 @@ void pack_spotlights_frame(const Scene& scene, FrameData& data) {
         g.axis_cos = glm::vec4(glm::vec3(axis), float(std::cos(angle)));
         g.intensity_edge = glm::vec4(spot.intensity, float(q));
         g.cone = glm::vec4(float(std::sin(angle) * std::sin(angle)), float(one_minus_cos),
-                           float((1.0 - q) / one_minus_cos), 0.0f);
+                           float((1.0 - q) / one_minus_cos), spot.volumetric_shadows ? 1.0f : 0.0f);
         data.spot_lights.push_back(g);
     }
     data.frame.spot_light_count = int(data.spot_lights.size());

@@ -41,7 +41,7 @@ struct Image {
     int height = 0;
     std::vector<float> rgb;
     int output_floats = 0;
-    std::vector<float> outputs;
+    std::vector<float> outputs{};
 };
 
 // One of the outputs a render can give (README "Render outputs"): its name,

@@ -69,6 +69,9 @@ struct PointLight {
     glm::vec3 position{0.0f};
     Rgb intensity{0.0f};
     float radius = 0.05f;
+    // Its airlight only from the parts of each view ray it lights, the rest
+    // shadowed by the surfaces (effects/light_shafts/physics.md section 7).
+    bool volumetric_shadows = false;
 };
 
 // Spot light (effects/spotlights/physics.md): a lamp at `position` shining along the unit
@@ -83,6 +86,7 @@ struct SpotLight {
     float cone_angle_degrees = 30.0f;
     float edge = 0.0f;
     float radius = 0.05f;
+    bool volumetric_shadows = false;  // as PointLight's
 };
 
 enum class SurfaceType { plane, box, sphere };
