@@ -134,14 +134,17 @@ def rainbow_figures(backend: str, out: Path, sequence_out: Path) -> None:
 
 
 def light_shafts_figure(backend: str, out: Path) -> None:
-    """Each light-shafts preset with and without shafts, a row each."""
+    """Each light-shafts preset with and without shafts, a row each (the lamps' presets
+    toggle their lights' volumetric_shadows)."""
     rows = []
     with airlight.Renderer(backend) as r:
-        for name in ("shafts_low_sun", "shafts_sun_behind", "shafts_rain_rainbow"):
+        for name in ("shafts_low_sun", "shafts_sun_behind", "shafts_rain_rainbow", "shafts_lamp_alley"):
             tiles = []
             for shafts in ("analytic", "off"):
                 scene = airlight.preset(name)
                 scene.setdefault("quality", {})["shafts"] = shafts
+                for light in scene.get("lights", []):
+                    light["volumetric_shadows"] = shafts != "off" and light.get("volumetric_shadows", False)
                 tiles.append(airlight.display_scene(r.render(scene, width=320, height=180), scene))
                 tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
             rows.append(np.concatenate(tiles[:-1], axis=1))

@@ -79,12 +79,15 @@ bool same_scene(const airlight::Scene& a, const airlight::Scene& b) {
         return false;
     for (std::size_t i = 0; i < a.point_lights.size(); ++i) {
         const auto &x = a.point_lights[i], &y = b.point_lights[i];
-        if (!(same(x.position, y.position) && same(x.intensity, y.intensity) && x.radius == y.radius)) return false;
+        if (!(same(x.position, y.position) && same(x.intensity, y.intensity) && x.radius == y.radius &&
+              x.volumetric_shadows == y.volumetric_shadows))
+            return false;
     }
     for (std::size_t i = 0; i < a.spot_lights.size(); ++i) {
         const auto &x = a.spot_lights[i], &y = b.spot_lights[i];
         if (!(same(x.position, y.position) && same(x.direction, y.direction) && same(x.intensity, y.intensity) &&
-              x.cone_angle_degrees == y.cone_angle_degrees && x.edge == y.edge && x.radius == y.radius))
+              x.cone_angle_degrees == y.cone_angle_degrees && x.edge == y.edge && x.radius == y.radius &&
+              x.volumetric_shadows == y.volumetric_shadows))
             return false;
     }
     for (std::size_t i = 0; i < a.surfaces.size(); ++i) {
@@ -995,7 +998,8 @@ void test_spot_lights() {
                            {"direction", {3, 0, -4}},
                            {"intensity", {1, 2, 3}},
                            {"cone_angle", 1e-3},
-                           {"edge", 1}});
+                           {"edge", 1},
+                           {"volumetric_shadows", true}});
     j["lights"].push_back({{"type", "spot"},
                            {"position", {0, 0, 0}},
                            {"direction", {0.6, 0.8, 0}},
@@ -1014,6 +1018,7 @@ void test_spot_lights() {
     CHECK(std::abs(glm::length(b.direction) - 1.0f) < 1e-6f);
     CHECK(same(b.intensity, {1.0f, 2.0f, 3.0f}));
     CHECK(b.cone_angle_degrees == 1e-3f && b.edge == 1.0f && b.radius == 0.05f);
+    CHECK(b.volumetric_shadows && !a.volumetric_shadows && !c.volumetric_shadows);
     CHECK(same(c.direction, {0.6f, 0.8f, 0.0f}));  // unit to float precision: kept as given
     CHECK(c.cone_angle_degrees == 45.5f && c.edge == 0.0f);
 
@@ -1023,12 +1028,14 @@ void test_spot_lights() {
     CHECK(v["lights"][0]["type"] == "point");
     CHECK(v["lights"][1]["type"] == "spot" && v["lights"][2]["type"] == "spot" && v["lights"][3]["type"] == "spot");
     const json& w = v["lights"][1];
-    CHECK(w.size() == 7);
+    CHECK(w.size() == 8);
+    CHECK(w["volumetric_shadows"] == false);
     CHECK(w["position"] == json::array({0.0, 5.0, 0.0}));
     CHECK(w["direction"] == json::array({0.0, -1.0, 0.0}));
     CHECK(w["intensity"] == json::array({7.0, 7.0, 7.0}));
     CHECK(w["cone_angle"] == 90.0 && w["edge"] == 0.0 && w["radius"] == 0.05);
     CHECK(v["lights"][2]["edge"] == 1.0 && v["lights"][2]["cone_angle"] == 0.001);
+    CHECK(v["lights"][2]["volumetric_shadows"] == true);
     CHECK(!v["lights"][0].contains("direction") && !v["lights"][0].contains("cone_angle"));
     airlight::Scene r = airlight::parse_scene_json(v);
     CHECK(same_scene(s, r));
