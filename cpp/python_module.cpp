@@ -22,6 +22,7 @@
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
 #include "airlight_tables.hpp"
+#include "noise.hpp"
 #include "phase_tables.hpp"
 #include "plane_parallel.hpp"
 #include "point_source.hpp"
@@ -451,6 +452,23 @@ PYBIND11_MODULE(_core, m) {
         }
         return out;
     });
+    // The noise clouds' textures (effects/noise_clouds/noise.hpp), for the
+    // float64 reference of tests and benchmarks: (shape, detail), each an
+    // (n, n, n, 4) float32 array indexed [k, j, i, channel] (z, y, x).
+    m.def(
+        "cloud_noise_textures",
+        [](int seed) {
+            if (seed < 0 || seed > (1 << 30)) throw py::value_error("seed: must be in [0, 1073741824]");
+            const airlight::CloudNoise noise = airlight::cloud_noise_textures(seed);
+            auto as_array = [](const airlight::Table2D& t) {
+                const py::ssize_t n = t.width;
+                py::array_t<float> out({n, n, n, py::ssize_t(4)});
+                std::memcpy(out.mutable_data(), t.texels.data(), t.texels.size() * sizeof(float));
+                return out;
+            };
+            return py::make_tuple(as_array(*noise.shape), as_array(*noise.detail));
+        },
+        py::arg("seed"));
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

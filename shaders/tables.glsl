@@ -62,3 +62,26 @@ float gauss4_weight(int k) {
     return (k == 0 || k == 3) ? 0.3478548451374538f : 0.6521451548625461f;
 }
 
+
+// Manual trilinear interpolation of a tiling n^3 RGBA texture stored as a
+// stacked table (width n, height n^2: texel (i, j, k) at column i, row
+// k n + j; effects/noise_clouds/noise.hpp) at u in tile units, texel centres at
+// (i + 1/2) / n, wrapping (effects/noise_clouds/physics.md eq. 1.1).
+vec4 table_trilinear4_periodic(int table, int n, vec3 u) {
+    vec3 f = float(n) * (u - floor(u)) - vec3(0.5f);
+    vec3 corner = floor(f);
+    vec3 a = f - corner;
+    int i0 = (int(corner.x) + n) % n;
+    int j0 = (int(corner.y) + n) % n;
+    int k0 = (int(corner.z) + n) % n;
+    int i1 = (i0 + 1) % n;
+    int row00 = k0 * n + j0;
+    int row10 = k0 * n + (j0 + 1) % n;
+    int row01 = ((k0 + 1) % n) * n + j0;
+    int row11 = ((k0 + 1) % n) * n + (j0 + 1) % n;
+    vec4 near = mix(mix(table_texel4(table, i0, row00), table_texel4(table, i1, row00), a.x),
+                    mix(table_texel4(table, i0, row10), table_texel4(table, i1, row10), a.x), a.y);
+    vec4 far = mix(mix(table_texel4(table, i0, row01), table_texel4(table, i1, row01), a.x),
+                   mix(table_texel4(table, i0, row11), table_texel4(table, i1, row11), a.x), a.y);
+    return mix(near, far, a.z);
+}

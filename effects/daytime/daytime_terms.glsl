@@ -30,29 +30,48 @@ vec3 sky_escaping_radiance(vec3 dir) {
     return sky_radiance(dir);
 }
 
-// Hook view_transfer: aerial perspective on whatever the ray ends at, plus the
-// sky and sun light the atmosphere's particles scatter toward the camera (and
-// the homogeneous medium's sunlight, which varies with the atmosphere's
-// transmittance to each altitude), the sun's over the lit parts of the ray.
-vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
-    if (!HAS_ATMOSPHERE) return radiance;
+// The atmosphere's transfer over [a, b] of the view ray (b = NO_HIT: to
+// infinity): aerial perspective on `radiance` arriving at b, plus the sky and
+// sun light the atmosphere's particles scatter toward the camera (and the
+// homogeneous medium's sunlight, which varies with the atmosphere's
+// transmittance to each altitude), the sun's over the lit parts of the ray;
+// the light from beyond a reaches the camera through the homogeneous medium
+// before a. The clouds call it on the parts of the ray around their layer
+// (effects/noise_clouds/physics.md section 5).
+vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance) {
+    if (!HAS_ATMOSPHERE || !(b > a)) return radiance;
+    vec3 start = origin + a * dir;
+    float length_ = b >= NO_HIT ? NO_HIT : b - a;
     vec3 sigma_medium = HAS_MEDIUM ? vec3(frame.sigma_t) : vec3(0.0f);
     vec3 inscatter;
     vec3 rainbow;  // the rain's sunlight, kept apart only for the render outputs (rainbow_layer_apart)
     vec3 medium_sun;  // the homogeneous medium's sunlight (HAS_MEDIUM_SUN; effects/light_shafts)
     vec3 through_atmosphere;
     if (SKY_MARCH) {
-        atmosphere_scattering_march(origin, dir, t_hit, sigma_medium, int(frame.march_steps), inscatter, rainbow,
+        atmosphere_scattering_march(start, dir, length_, sigma_medium, int(frame.march_steps), inscatter, rainbow,
                                     medium_sun, through_atmosphere);
     } else {
         // The sun's shadows along the ray (effects/light_shafts): counted by the volumes.
-        sun_shadow_runs(origin, dir, t_hit);
-        atmosphere_scattering(origin, dir, t_hit, sigma_medium, true, inscatter, rainbow, medium_sun,
+        sun_shadow_runs(start, dir, length_);
+        atmosphere_scattering(start, dir, length_, sigma_medium, true, inscatter, rainbow, medium_sun,
                               through_atmosphere);
+    }
+    if (a > 0.0f) {
+        vec3 before = exp(-sigma_medium * a);
+        inscatter *= before;
+        rainbow *= before;
+        medium_sun *= before;
     }
     outputs_attenuate(through_atmosphere);
     layer_add(LAYER_SKY, inscatter);
     layer_add(LAYER_RAINBOW, rainbow);
     layer_add(LAYER_MEDIUM_SUN, medium_sun);
     return radiance * through_atmosphere + inscatter + rainbow + medium_sun;
+}
+
+// Hook view_transfer: the atmosphere along the whole view ray [0, t_hit]; with
+// clouds, their transfer calls atmosphere_segment_transfer around their layer instead.
+vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
+    if (HAS_CLOUDS) return radiance;
+    return atmosphere_segment_transfer(origin, dir, 0.0f, t_hit, radiance);
 }

@@ -11,13 +11,15 @@ vec3 medium_sun_source(vec3 d) {
 }
 
 // The sun's light scattered once toward the camera by the homogeneous medium
-// along [0, t_hit], without an atmosphere (with one, the atmosphere's
-// scattering volumes carry it: effects/daytime/sky.glsl): sigma_s p E_sun
-// times int e^{-sigma_t t} dt over the lit parts of the ray (physics.md
-// eq. 3.2), exact; or, with SHAFTS_MARCH, a midpoint march of frame.march_steps
-// steps with a shadow ray each, to t_hit or where e^{-sigma_t t} < e^{-30}.
-vec3 medium_sun_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
-    if (!HAS_MEDIUM_SUN || HAS_ATMOSPHERE) return radiance;
+// along [a, b] of the view ray (b = NO_HIT: to infinity), without an
+// atmosphere (with one, the atmosphere's scattering volumes carry it:
+// effects/daytime/sky.glsl): sigma_s p E_sun times int e^{-sigma_t t} dt over
+// the lit parts of [a, b] (physics.md eq. 3.2), exact; or, with SHAFTS_MARCH,
+// a midpoint march of frame.march_steps steps with a shadow ray each, to b or
+// where e^{-sigma_t t} < e^{-30}. The clouds call it on the parts of the ray
+// around their layer (effects/noise_clouds/physics.md section 5).
+vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance) {
+    if (!HAS_MEDIUM_SUN || HAS_ATMOSPHERE || !(b > a)) return radiance;
     vec3 sigma = vec3(frame.sigma_t);
     vec3 light = vec3(0.0f);
     if (SHAFTS_MARCH) {
@@ -25,23 +27,32 @@ vec3 medium_sun_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance)
         for (int c = 0; c < 3; ++c) {
             if (frame.sigma_s[c] > 0.0f) thinnest = min(thinnest, sigma[c]);
         }
-        float far = min(t_hit, 30.0f / thinnest);
+        float far = min(b, 30.0f / thinnest);
         int steps = int(frame.march_steps);
-        float ds = far / float(steps);
-        for (int k = 0; k < steps; ++k) {
-            float t = (float(k) + 0.5f) * ds;
+        float ds = (far - a) / float(steps);
+        for (int k = 0; k < steps && ds > 0.0f; ++k) {
+            float t = a + (float(k) + 0.5f) * ds;
             light += sun_visible_from_air(origin + t * dir) * exp(-sigma * t) * ds;
         }
     } else {
-        sun_shadow_runs(origin, dir, t_hit);
-        float lit_from = 0.0f;
+        sun_shadow_runs(origin, dir, b);
+        float lit_from = a;
         for (int k = 0; k < shadow_runs.count; ++k) {
-            light += attenuated_length(sigma, lit_from, shadow_runs.run[k].x);
-            lit_from = shadow_runs.run[k].y;
+            vec2 run = shadow_runs.run[k];
+            if (run.x > lit_from) light += attenuated_length(sigma, lit_from, run.x);
+            lit_from = max(lit_from, run.y);
         }
-        if (lit_from < t_hit) light += attenuated_length(sigma, lit_from, t_hit);
+        if (lit_from < b) light += attenuated_length(sigma, lit_from, b);
     }
     light *= medium_sun_source(dir);
     layer_add(LAYER_MEDIUM_SUN, light);
     return radiance + light;
+}
+
+// Hook view_transfer: the homogeneous medium's sunlight along the whole view
+// ray [0, t_hit]; with clouds, their transfer calls
+// medium_sun_segment_transfer around their layer instead.
+vec3 medium_sun_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
+    if (HAS_CLOUDS) return radiance;
+    return medium_sun_segment_transfer(origin, dir, 0.0f, t_hit, radiance);
 }

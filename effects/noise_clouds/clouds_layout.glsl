@@ -1,0 +1,16 @@
+// The noise clouds' frame data (EFFECT_GLSL_LAYOUT: compiled after
+// shaders/constants.glsl, before FrameUniforms in shaders/frame.glsl; 4-byte
+// scalars in groups of four, vec4, ivec4, so std140 and C++ agree).
+
+// Texels per side of the two tiling noise textures (physics.md section 1).
+CONST int CLOUD_SHAPE_SIZE = 128;
+CONST int CLOUD_DETAIL_SIZE = 32;
+
+// The cloud layer (physics.md): its extent, density parameters and march.
+struct CloudsGpu {
+    vec4 layer;     // x: base (m), y: top (m), z: 1 / (top - base), w: extinction at density 1 (1/m)
+    vec4 tiles;     // x: 1 / shape_scale, y: 1 / detail_scale (tiles per metre), z, w: unused
+    vec4 offsets;   // the wind's drift in tile units, fract(wind time / scale): x, y shape (along x, z), z, w detail
+    vec4 density;   // x: coverage, y: type, z: erosion, w: albedo
+    vec4 lighting;  // x: Henyey-Greenstein g, y: view steps across the layer, z: light steps, w: unused
+};

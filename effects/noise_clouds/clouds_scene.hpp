@@ -1,0 +1,40 @@
+// The noise clouds' scene data: the cloud layer ("clouds" in the scene format)
+// and its quality settings (clouds_keys.cpp parses them; physics.md defines
+// every field's meaning).
+#pragma once
+
+namespace airlight {
+
+// A layer of cloud between two altitudes whose density comes from two tiling
+// noise textures (physics.md sections 1 and 2).
+struct Clouds {
+    bool present = false;
+    float base = 1500.0f;         // m: the layer's bottom (density 0 there)
+    float top = 4000.0f;          // m: its top
+    float coverage = 0.5f;        // [0, 1]: the fraction of the sky the layer covers (0: none)
+    float type = 0.5f;            // [0, 1]: the height profile, 0 stratus, 0.5 cumulus, 1 cumulonimbus
+    float extinction = 0.05f;     // 1/m: sigma_t at density 1
+    float albedo = 1.0f;          // single-scattering albedo (water droplets: 1)
+    float g = 0.2f;               // Henyey-Greenstein asymmetry of the droplets' lobe
+    float erosion = 0.35f;        // [0, 1]: how far the detail noise eats into the edges (eq. 2.4)
+    float shape_scale = 8000.0f;  // m: the shape texture's tile
+    float detail_scale = 600.0f;  // m: the detail texture's tile
+    float wind_x = 0.0f;          // m/s: the field's drift along x
+    float wind_z = 0.0f;          // m/s: along z
+    float time = 0.0f;            // s: the field has drifted by wind * time
+    int seed = 0;                 // the noise textures' seed
+};
+
+enum class CloudsMethod {
+    adaptive,  // steps growing with distance, empty space crossed in long steps, early stop (physics.md section 4)
+    march,     // fixed steps over the layer's part of the ray (quality.march_steps): brute force, for comparison
+};
+
+// The noise clouds' quality settings (a base of Quality).
+struct CloudsQuality {
+    CloudsMethod clouds = CloudsMethod::adaptive;
+    int cloud_steps = 96;       // view-ray steps across the layer's thickness near the camera
+    int cloud_light_steps = 8;  // steps of each march toward the sun and upward (eq. 3.2)
+};
+
+}  // namespace airlight

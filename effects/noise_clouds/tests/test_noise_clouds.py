@@ -1,0 +1,219 @@
+"""Noise clouds (issue 21; effects/noise_clouds/physics.md): the scene keys, the noise
+textures, what a scene without clouds pays, both backends agreeing, robustness over
+wide parameter ranges and the wind's continuity. The comparisons with the float64
+reference are in test_clouds_against_reference.py."""
+
+from __future__ import annotations
+
+import copy
+import json
+import subprocess
+import sys
+import textwrap
+from typing import Any
+
+import numpy as np
+import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
+
+import airlight
+
+SKY_SCENE: dict[str, Any] = {
+    "film": {"width": 48, "height": 27},
+    "camera": {"position": [0, 2, 0], "look_at": [0, 900, -3000], "up": [0, 1, 0], "fov_y": 70},
+    "sky": {"model": "cie", "type": 12, "zenith_radiance": [0.5, 0.75, 1.3]},
+    "sun": {"elevation": 30, "azimuth": 20, "irradiance": [12, 11.5, 10.5]},
+    "surfaces": [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 0.2}],
+    "clouds": {"base": 1500, "top": 4000, "coverage": 0.6, "extinction": 0.05},
+    "quality": {"multiple_scattering": False},
+}
+
+
+def with_clouds(**clouds: Any) -> dict[str, Any]:
+    scene = copy.deepcopy(SKY_SCENE)
+    scene["clouds"].update(clouds)
+    return scene
+
+
+# ---- Scene keys -------------------------------------------------------------------------------
+
+def test_cloud_keys_are_read_with_defaults_and_written_back():
+    scene = airlight.load_scene({**SKY_SCENE, "clouds": {}})
+    c = scene["clouds"]
+    assert c == {"base": 1500.0, "top": 4000.0, "coverage": 0.5, "type": 0.5, "extinction": 0.05,
+                 "albedo": 1.0, "g": pytest.approx(0.2), "erosion": pytest.approx(0.35),
+                 "shape_scale": 8000.0, "detail_scale": 600.0, "wind": [0.0, 0.0], "time": 0.0, "seed": 0}
+    q = scene["quality"]
+    assert (q["clouds"], q["cloud_steps"], q["cloud_light_steps"]) == ("adaptive", 96, 8)
+    given_keys = {"base": 800, "top": 1200, "coverage": 1, "type": 0, "extinction": 0.2, "albedo": 0.9,
+                  "g": 0.5, "erosion": 0.1, "shape_scale": 5000, "detail_scale": 300, "wind": [10, -5],
+                  "time": 60, "seed": 7}
+    again = airlight.load_scene({**SKY_SCENE, "clouds": given_keys,
+                                 "quality": {"clouds": "march", "cloud_steps": 200, "cloud_light_steps": 3}})
+    read = dict(again["clouds"])
+    assert read.pop("wind") == [10.0, -5.0]
+    assert read == pytest.approx({k: v for k, v in given_keys.items() if k != "wind"})
+    assert airlight.load_scene(again) == again
+    assert airlight.load_scene({**SKY_SCENE, "clouds": None})["clouds"] is None
+
+
+@pytest.mark.parametrize("clouds, field, error", [
+    ({"coverage": 1.5}, "clouds.coverage", ValueError),
+    ({"base": 3000, "top": 2000}, "clouds.top", ValueError),
+    ({"base": 5000}, "clouds.base", ValueError),
+    ({"extinction": -1}, "clouds.extinction", ValueError),
+    ({"wind": [1, 2, 3]}, "clouds.wind", TypeError),
+    ({"wind": [1, "x"]}, "clouds.wind[1]", TypeError),
+    ({"seed": 1.5}, "clouds.seed", ValueError),
+    ({"g": 1}, "clouds.g", ValueError),
+    ({"colour": 1}, "clouds.colour", ValueError),
+])
+def test_bad_cloud_keys_name_the_field(clouds, field, error):
+    with pytest.raises(error, match=field.replace("[", r"\[").replace("]", r"\]")):
+        airlight.load_scene({**SKY_SCENE, "clouds": clouds})
+
+
+def test_bad_cloud_quality_names_the_field():
+    with pytest.raises(ValueError, match="quality.clouds"):
+        airlight.load_scene({**SKY_SCENE, "quality": {"clouds": "fast"}})
+    with pytest.raises(ValueError, match="quality.cloud_steps"):
+        airlight.load_scene({**SKY_SCENE, "quality": {"cloud_steps": 1}})
+
+
+# ---- The noise textures -----------------------------------------------------------------------
+
+def test_noise_textures_are_deterministic_per_seed_in_range_and_tile_without_seams():
+    shape, detail = airlight._core.cloud_noise_textures(3)
+    again = airlight._core.cloud_noise_textures(3)
+    assert shape.shape == (128, 128, 128, 4) and detail.shape == (32, 32, 32, 4)
+    assert np.array_equal(shape, again[0]) and np.array_equal(detail, again[1])
+    assert not np.array_equal(shape, airlight._core.cloud_noise_textures(4)[0])
+    for tex in (shape, detail):
+        assert tex.min() >= 0.0 and tex.max() <= 1.0
+        for axis in range(3):
+            # Across the tile's edge (texel n-1 to texel 0) the noise changes as between any two
+            # neighbours: a seam would show a jump far above the interior's steps.
+            seam = np.abs(np.take(tex, [0], axis) - np.take(tex, [-1], axis)).mean()
+            inner = np.abs(np.diff(tex, axis=axis)).mean()
+            assert seam < 1.5 * inner, (axis, seam, inner)
+    # The channels are at rising frequencies: the mean step between neighbours grows.
+    steps = [np.abs(np.diff(detail[..., c], axis=2)).mean() for c in range(4)]
+    assert steps == sorted(steps)
+
+
+NO_CLOUD_TABLES = textwrap.dedent("""
+    import json, sys, airlight
+    airlight.render(json.loads(sys.argv[1]), backend="cpu")
+    print(json.dumps(sorted(airlight.table_stats())))
+""")
+
+
+def tables_built_by(scene: dict[str, Any]) -> list[str]:
+    out = subprocess.run([sys.executable, "-c", NO_CLOUD_TABLES, json.dumps(scene)], capture_output=True,
+                         text=True, check=True)
+    return json.loads(out.stdout)
+
+
+@pytest.mark.parametrize("clouds", [None, {"coverage": 0}, {"extinction": 0}])
+def test_scene_without_visible_clouds_builds_no_noise(clouds):
+    scene = {**SKY_SCENE, "clouds": clouds}
+    built = tables_built_by(scene)
+    assert not any(name.startswith("cloud_") for name in built), built
+
+
+def test_scene_with_clouds_builds_both_noise_textures():
+    built = tables_built_by(SKY_SCENE)
+    assert {"cloud_shape", "cloud_detail"} <= set(built)
+
+
+# ---- Rendering ---------------------------------------------------------------------------------
+
+def test_clouds_agree_on_both_backends(renderer_cache):
+    scene = copy.deepcopy(SKY_SCENE)
+    cpu = renderer_cache("cpu").render(scene, outputs=["radiance", "clouds", "transmittance"])
+    gl = renderer_cache("gl").render(scene, outputs=["radiance", "clouds", "transmittance"])
+    assert cpu["clouds"].max() > 1e-3  # the clouds show
+    for name in ("radiance", "clouds", "transmittance"):
+        np.testing.assert_allclose(gl[name], cpu[name], rtol=2e-4, atol=1e-6 * float(cpu[name].max()))
+
+
+def test_zero_coverage_renders_as_no_clouds(renderer):
+    without = renderer.render({**SKY_SCENE, "clouds": None})
+    assert np.array_equal(renderer.render(with_clouds(coverage=0)), without)
+
+
+def test_clouds_darken_the_sky_behind_them_and_add_their_light(renderer):
+    scene = copy.deepcopy(SKY_SCENE)
+    out = renderer.render(scene, outputs=["radiance", "clouds", "transmittance", "sky"])
+    clear = renderer.render({**scene, "clouds": None}, outputs=["radiance", "transmittance"])
+    t = out["transmittance"]
+    assert t.min() < 0.5 and np.all(t <= clear["transmittance"] + 1e-6)
+    # Where the view ray misses the layer (the ground) nothing changes.
+    below = slice(SKY_SCENE["film"]["height"] * 3 // 4, None)
+    assert np.array_equal(out["radiance"][below], clear["radiance"][below])
+
+
+@pytest.mark.parametrize("method", ["adaptive", "march"])
+def test_clouds_layer_and_the_others_sum_to_the_radiance(renderer, method):
+    from test_render_outputs import assert_layers_sum_to_radiance
+
+    scene = with_clouds()
+    scene["atmosphere"] = {"molecules": {"density_scale": 1}, "aerosol": {"visibility": 30000}}
+    scene["quality"] = {"multiple_scattering": False, "clouds": method, "march_steps": 64}
+    out = renderer.render(scene, outputs=["radiance", "layers"])
+    assert out["clouds"].max() > 0.0
+    assert_layers_sum_to_radiance(out, f"clouds, {method} ({renderer.backend})")
+
+
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(data=st.data())
+def test_no_nan_inf_or_negative_radiance_over_wide_parameters(renderer_cache, data):
+    """Camera below, inside, on the boundary or above the layer, looking anywhere; coverage and
+    extinction from 0 to their limits; the sun from below the horizon to the zenith."""
+    draw = data.draw
+    base = draw(st.floats(0, 5000))
+    top = base + draw(st.sampled_from([1.0, 50.0, 2000.0, 8000.0]))
+    y = draw(st.sampled_from([0.5, base, top, 0.5 * (base + top), top + 100, base - 1e-3]))
+    look = [draw(st.floats(-1, 1)), draw(st.floats(-1, 1)), draw(st.floats(-1, 1))]
+    if np.linalg.norm(look) < 1e-3 or abs(look[1]) > 0.999 * np.linalg.norm(look):
+        look = [0.0, 0.1, -1.0]
+    scene = with_clouds(base=base, top=top, coverage=draw(st.sampled_from([0.0, 0.3, 1.0])),
+                        extinction=draw(st.sampled_from([0.0, 1e-4, 0.05, 1e3])),
+                        type=draw(st.floats(0, 1)), g=draw(st.floats(-0.9, 0.9)),
+                        wind=[draw(st.floats(-50, 50)), 0.0], time=draw(st.floats(0, 1e5)))
+    scene["film"] = {"width": 12, "height": 8}
+    scene["camera"] = {"position": [0.0, y, 0.0], "look_at": [look[0], y + look[1], look[2]], "up": [0, 1, 0],
+                       "fov_y": 60}
+    scene["sun"] = {"elevation": draw(st.sampled_from([-5.0, 0.0, 0.5, 30.0, 90.0])), "azimuth": 20,
+                    "irradiance": [12, 11.5, 10.5]}
+    backend = draw(st.sampled_from(["cpu", "gl"]))
+    out = renderer_cache(backend).render(scene, outputs=["radiance", "clouds"])
+    for name in ("radiance", "clouds"):
+        assert np.all(np.isfinite(out[name])), name
+        assert out[name].min() >= 0.0, name
+
+
+def test_wind_moves_the_clouds_continuously(renderer):
+    """Frame differences shrink in proportion as the time step shrinks (no jumps)."""
+    scene = with_clouds(wind=[15.0, 5.0])
+    frames = {dt: renderer.render(with_clouds(wind=[15.0, 5.0], time=100.0 + dt)) for dt in (0.0, 1.0, 4.0)}
+    base = renderer.render(scene | {"clouds": {**scene["clouds"], "time": 100.0}})
+    assert np.array_equal(base, frames[0.0])
+    small = np.abs(frames[1.0] - frames[0.0]).mean()
+    large = np.abs(frames[4.0] - frames[0.0]).mean()
+    assert 0 < small < large
+    assert large / small == pytest.approx(4.0, rel=0.5)
+
+
+def test_wind_drift_is_the_field_shifted(renderer):
+    """The field at time t with wind w is the field at time 0 moved by w t: a camera moved with
+    it sees the same clouds (up to float32 rounding of the tile offsets)."""
+    shift = [400.0, 0.0, -250.0]
+    moved = copy.deepcopy(with_clouds(wind=[4.0, -2.5], time=100.0))
+    for key in ("position", "look_at"):
+        moved["camera"][key] = [a + b for a, b in zip(moved["camera"][key], shift)]
+    still = with_clouds()
+    a = renderer.render(still, outputs=["clouds"])["clouds"]
+    b = renderer.render(moved, outputs=["clouds"])["clouds"]
+    assert np.abs(a - b).max() <= 1e-3 * a.max()
