@@ -10,7 +10,7 @@ vec3 sky_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
 }
 
 // Hook surface_irradiance: the sun's, where the point sees it (sun_visibility:
-// a shadow ray, or the map of effects/sun_shadow_map); with multiple
+// a shadow ray, or the map of effects/sun_shadow_map) through the clouds; with multiple
 // scattering, its forward-scattered residual beam E_res too, which travels
 // nearly along the sun and is shadowed with it
 // (effects/multiple_scattering/physics.md section 9).
@@ -21,6 +21,8 @@ vec3 sun_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     if (visible <= 0.0f) return vec3(0.0f);
     vec3 e = sun_irradiance(p, n);
     if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) e += ms_sun_residual(ms_level(max(p.y, 0.0f))) * cos_n;
+    // The clouds' shadow (effects/noise_clouds/physics.md section 5).
+    if (HAS_CLOUDS) visible *= cloud_transmittance_from(p, vec3(frame.sky.sun_direction));
     return visible * e;
 }
 

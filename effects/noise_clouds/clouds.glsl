@@ -9,8 +9,6 @@
 CONST float CLOUD_SKIP_FACTOR = 4.0f;
 // The adaptive march's step grows by the near step every this many metres from the camera.
 CONST float CLOUD_STEP_GROWTH = 10000.0f;
-// The adaptive march stops once the clouds' transmittance falls below this.
-CONST float CLOUD_OPAQUE = 1.0e-4f;
 // Light marches along a nearly horizontal direction end this far away (the
 // layer does not end there, but its light is long gone: an optical depth of at
 // least the density's mean times this).
@@ -18,8 +16,9 @@ CONST float CLOUD_LIGHT_FAR = 100000.0f;
 // View rays end this far from the camera inside the layer (a ray grazing the
 // layer for longer has met opaque cloud or left the film's resolution long before).
 CONST float CLOUD_VIEW_FAR = 200000.0f;
-// Ratio of consecutive light-march steps (the first is the shortest).
-CONST float CLOUD_LIGHT_GROWTH = 1.5f;
+// The light march's last step over its first (the steps grow geometrically
+// in between, so that they refine everywhere as their count grows).
+CONST float CLOUD_LIGHT_GROWTH = 16.0f;
 
 // The height profile H(h, type) (physics.md section 2): a trapezoid in the
 // height fraction h, its corners (rise end a, fall start b, top t) linear in
@@ -89,16 +88,16 @@ float cloud_exit_distance(vec3 p, vec3 w) {
     return clamp(s, 0.0f, CLOUD_LIGHT_FAR);
 }
 
-// The clouds' transmittance from p along w out of the layer, T_c of eq. 3.2:
-// frame.clouds.lighting.z midpoint steps, each CLOUD_LIGHT_GROWTH times the
-// one before (CLOUDS_MARCH: equal steps).
-float cloud_transmittance_toward(vec3 p, vec3 w) {
+// The clouds' optical depth from p along w out of the layer, the exponent of
+// T_c of eq. 3.2: frame.clouds.lighting.z midpoint steps growing geometrically,
+// the last CLOUD_LIGHT_GROWTH times the first (CLOUDS_MARCH: equal steps).
+float cloud_optical_depth_toward(vec3 p, vec3 w) {
     float length_out = cloud_exit_distance(p, w);
-    if (!(length_out > 0.0f)) return 1.0f;
+    if (!(length_out > 0.0f)) return 0.0f;
     int steps = int(frame.clouds.lighting.z);
-    float r = CLOUDS_MARCH ? 1.0f : CLOUD_LIGHT_GROWTH;
-    // The first step: length_out (r - 1) / (r^n - 1), or length_out / n for r = 1.
-    float ds = CLOUDS_MARCH ? length_out / float(steps) : length_out * (r - 1.0f) / (pow(r, float(steps)) - 1.0f);
+    // The ratio r of consecutive steps and the first, length_out (r - 1) / (r^n - 1) (equal steps for r = 1).
+    float r = CLOUDS_MARCH || steps < 2 ? 1.0f : pow(CLOUD_LIGHT_GROWTH, 1.0f / float(steps - 1));
+    float ds = r == 1.0f ? length_out / float(steps) : length_out * (r - 1.0f) / (pow(r, float(steps)) - 1.0f);
     float s = 0.0f;
     float depth = 0.0f;
     for (int k = 0; k < steps; ++k) {
@@ -106,24 +105,89 @@ float cloud_transmittance_toward(vec3 p, vec3 w) {
         s += ds;
         ds *= r;
     }
-    return exp(-frame.clouds.layer.w * depth);
+    return frame.clouds.layer.w * depth;
+}
+
+// The clouds' transmittance from any point p along w (w.y != 0 for a point
+// outside the layer): from where w enters the layer, 1 where it never does.
+// The clouds' shadow on surfaces (the sun's light, effects/daytime/daytime_terms.glsl).
+float cloud_transmittance_from(vec3 p, vec3 w) {
+    float base = frame.clouds.layer.x;
+    float top = frame.clouds.layer.y;
+    if (p.y < base) {
+        if (!(w.y > 0.0f)) return 1.0f;
+        p += ((base - p.y) / w.y) * w;
+        p.y = base;
+    } else if (p.y > top) {
+        if (!(w.y < 0.0f)) return 1.0f;
+        p += ((top - p.y) / w.y) * w;
+        p.y = top;
+    }
+    return exp(-cloud_optical_depth_toward(p, w));
+}
+
+// Multiple scattering's octaves (eq. 6.1) for the sun: sum over i of a^i
+// e^{-b^i depth} p_HG(mu, c^i g); octave 0 alone is single scattering.
+float cloud_sun_octaves(float depth, float mu) {
+    vec4 oct = frame.clouds.octaves;
+    float sum = 0.0f;
+    float weight = 1.0f;
+    float depth_scale = 1.0f;
+    float g = frame.clouds.lighting.x;
+    for (int i = 0; i < int(oct.w); ++i) {
+        sum += weight * exp(-depth_scale * depth) * species_phase(vec4(g, 0.0f, 1.0f, 0.0f), mu);
+        weight *= oct.x;
+        depth_scale *= oct.y;
+        g *= oct.z;
+    }
+    return sum;
+}
+
+// The same for the sky's light (no phase: its mean over the hemisphere).
+float cloud_sky_octaves(float depth) {
+    vec4 oct = frame.clouds.octaves;
+    float sum = 0.0f;
+    float weight = 1.0f;
+    float depth_scale = 1.0f;
+    for (int i = 0; i < int(oct.w); ++i) {
+        sum += weight * exp(-depth_scale * depth);
+        weight *= oct.x;
+        depth_scale *= oct.y;
+    }
+    return sum;
 }
 
 // The light a unit of cloud density scatters toward the camera at p (view
 // direction d), per unit extinction: J / sigma_t of eq. 3.1, the sun's (with the
-// clouds' shadow) and the sky's (attenuated straight up).
+// clouds' shadow) and the sky's (attenuated straight up), each through the
+// octaves of eq. 6.1.
 vec3 cloud_source_function(vec3 p, vec3 d) {
     vec3 source = vec3(0.0f);
     if (HAS_SUN) {
         vec3 s = vec3(frame.sky.sun_direction);
-        vec4 hg = vec4(frame.clouds.lighting.x, 0.0f, 1.0f, 0.0f);  // species_phase's HG lobe
-        source += sun_irradiance(p, s) * (cloud_transmittance_toward(p, s) * species_phase(hg, dot(s, d)));
+        source += sun_irradiance(p, s) * cloud_sun_octaves(cloud_optical_depth_toward(p, s), dot(s, d));
     }
     if (HAS_SKY) {
         vec3 up = vec3(0.0f, 1.0f, 0.0f);
-        source += sky_irradiance(p, up) * (cloud_transmittance_toward(p, up) / (2.0f * PI));
+        source += sky_irradiance(p, up) * (cloud_sky_octaves(cloud_optical_depth_toward(p, up)) / (2.0f * PI));
     }
     return frame.clouds.density.w * source;
+}
+
+// An upper bound of cloud_source_function anywhere along the view direction d
+// (no cloud shadow, the sun's irradiance above the atmosphere, the sky's at
+// the layer's top): what the rest of a march can add per unit transmittance.
+vec3 cloud_source_bound(vec3 d) {
+    vec3 bound = vec3(0.0f);
+    if (HAS_SUN) {
+        vec3 s = vec3(frame.sky.sun_direction);
+        bound += vec3(frame.sky.sun_irradiance) * cloud_sun_octaves(0.0f, dot(s, d));
+    }
+    if (HAS_SKY) {
+        vec3 top = vec3(0.0f, frame.clouds.layer.y, 0.0f);
+        bound += sky_irradiance(top, vec3(0.0f, 1.0f, 0.0f)) * (cloud_sky_octaves(0.0f) / (2.0f * PI));
+    }
+    return frame.clouds.density.w * bound;
 }
 
 // One step of the view march (physics.md eq. 4.1): the sample at the step's
@@ -161,8 +225,11 @@ void cloud_march(vec3 origin, vec3 dir, float t0, float t1, OUT(vec3) light, OUT
         return;
     }
     float near_step = (frame.clouds.layer.y - frame.clouds.layer.x) / frame.clouds.lighting.y;
+    vec3 bound = cloud_source_bound(dir);
     float t = t0;
-    while (t < t1 && through_clouds > CLOUD_OPAQUE) {
+    // The rest of the ray adds at most through_clouds x bound: stop once that
+    // is below the culling fraction of the light found so far.
+    while (t < t1 && through_clouds > 0.0f && !negligible(through_clouds * bound, light)) {
         float dt = near_step * (1.0f + t / CLOUD_STEP_GROWTH);
         float long_step = min(CLOUD_SKIP_FACTOR * dt, t1 - t);
         // A long step whose middle has no cloud shape is crossed at once.

@@ -11,6 +11,14 @@ namespace airlight {
 
 namespace {
 
+// Multiple scattering's octaves (physics.md eq. 6.1): each octave's weight,
+// optical-depth and asymmetry factors and their count, fitted to Mitsuba 3's
+// path tracer (docs/multiple_scattering.md, bench/fit_octaves.py).
+constexpr float OCTAVE_WEIGHT = 0.5f;
+constexpr float OCTAVE_DEPTH = 0.5f;
+constexpr float OCTAVE_ASYMMETRY = 0.5f;
+constexpr int OCTAVE_COUNT = 4;
+
 // fract(x) of a drift in tile units, in double.
 float tile_fraction(double x) { return float(x - std::floor(x)); }
 
@@ -18,7 +26,7 @@ float tile_fraction(double x) { return float(x - std::floor(x)); }
 
 void pack_noise_clouds_frame(const Scene& scene, FrameData& data) {
     const Clouds& c = scene.clouds;
-    data.features.clouds = c.present && c.coverage > 0.0f && c.extinction > 0.0f;
+    data.features.clouds = clouds_visible(c);
     if (!data.features.clouds) return;
     data.features.clouds_march = scene.quality.clouds == CloudsMethod::march;
     shader::CloudsGpu& g = data.frame.clouds;
@@ -29,6 +37,9 @@ void pack_noise_clouds_frame(const Scene& scene, FrameData& data) {
                           tile_fraction(dx / c.detail_scale), tile_fraction(dz / c.detail_scale));
     g.density = glm::vec4(c.coverage, c.type, c.erosion, c.albedo);
     g.lighting = glm::vec4(c.g, float(scene.quality.cloud_steps), float(scene.quality.cloud_light_steps), 0.0f);
+    g.octaves = scene.quality.multiple_scattering
+                    ? glm::vec4(OCTAVE_WEIGHT, OCTAVE_DEPTH, OCTAVE_ASYMMETRY, float(OCTAVE_COUNT))
+                    : glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
     const CloudNoise noise = cloud_noise_textures(c.seed);
     data.use_table(shader::TABLE_CLOUD_SHAPE, noise.shape);
     data.use_table(shader::TABLE_CLOUD_DETAIL, noise.detail);

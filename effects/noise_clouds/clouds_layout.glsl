@@ -13,4 +13,5 @@ struct CloudsGpu {
     vec4 offsets;   // the wind's drift in tile units, fract(wind time / scale): x, y shape (along x, z), z, w detail
     vec4 density;   // x: coverage, y: type, z: erosion, w: albedo
     vec4 lighting;  // x: Henyey-Greenstein g, y: view steps across the layer, z: light steps, w: unused
+    vec4 octaves;   // multiple scattering's octaves (physics.md eq. 6.1): x: a, y: b, z: c, w: their count (1: single)
 };

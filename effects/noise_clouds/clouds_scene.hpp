@@ -25,6 +25,10 @@ struct Clouds {
     int seed = 0;                 // the noise textures' seed
 };
 
+// Clouds that can be seen or cast shadows: some coverage and extinction (a
+// scene without builds no texture and runs no cloud code).
+inline bool clouds_visible(const Clouds& c) { return c.present && c.coverage > 0.0f && c.extinction > 0.0f; }
+
 enum class CloudsMethod {
     adaptive,  // steps growing with distance, empty space crossed in long steps, early stop (physics.md section 4)
     march,     // fixed steps over the layer's part of the ray (quality.march_steps): brute force, for comparison
@@ -33,8 +37,8 @@ enum class CloudsMethod {
 // The noise clouds' quality settings (a base of Quality).
 struct CloudsQuality {
     CloudsMethod clouds = CloudsMethod::adaptive;
-    int cloud_steps = 96;       // view-ray steps across the layer's thickness near the camera
-    int cloud_light_steps = 8;  // steps of each march toward the sun and upward (eq. 3.2)
+    int cloud_steps = 96;        // view-ray steps across the layer's thickness near the camera
+    int cloud_light_steps = 32;  // steps of each march toward the sun and upward (eq. 3.2)
 };
 
 }  // namespace airlight

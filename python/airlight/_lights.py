@@ -24,7 +24,8 @@ def _sin_cos_degrees(angle: float) -> tuple[float, float]:
 def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.4, height: float = 0.65,
                intensity: float | Sequence[float] = (20000.0, 19000.0, 17000.0), cone_angle: float = 25.0,
                edge: float = 0.15, pitch: float = -2.0, lens_lamps: bool = False,
-               lens_intensity: float | Sequence[float] = 50.0, radius: float = 0.05) -> list[dict[str, Any]]:
+               lens_intensity: float | Sequence[float] = 50.0, radius: float = 0.05,
+               volumetric_shadows: bool = False) -> list[dict[str, Any]]:
     """A car's two headlights as light dicts for a scene's ``"lights"`` list.
 
     ``position`` is the car's front centre on the ground ``[x, y, z]`` (y is
@@ -39,6 +40,8 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
     emitting sphere. With ``lens_lamps=True`` two small point lamps of
     intensity ``lens_intensity`` and the same radius are added at the same
     places, so that the lenses are seen glowing from any direction.
+    ``volumetric_shadows=True`` makes the surfaces cast shadows into the fog
+    the beams light (effects/light_shafts/physics.md section 7).
 
     Returns ``[left spot, right spot]`` (left and right as seen from the
     driver's seat), followed by ``[left lamp, right lamp]`` with
@@ -70,6 +73,8 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
     lo, hi = _LIMITS["min_light_radius"], _LIMITS["max_light_radius"]
     if not lo <= radius <= hi:
         raise ValueError(f"radius: must be in [{lo:g}, {hi:g}], got {radius!r}")
+    if not isinstance(volumetric_shadows, bool):
+        raise TypeError(f"volumetric_shadows: expected a bool, got {type(volumetric_shadows).__name__}")
 
     sin_p, cos_p = _sin_cos_degrees(pitch)
     forward = (sin_h, 0.0, -cos_h)
@@ -79,7 +84,7 @@ def headlights(position: Sequence[float], heading: float, *, spacing: float = 1.
                origin[2] + side * 0.5 * spacing * right[2] + 0.0] for side in (-1.0, 1.0)]
     lights: list[dict[str, Any]] = [
         {"type": "spot", "position": list(at), "direction": list(direction), "intensity": list(rgb),
-         "cone_angle": cone_angle, "edge": edge, "radius": radius}
+         "cone_angle": cone_angle, "edge": edge, "radius": radius, "volumetric_shadows": volumetric_shadows}
         for at in places
     ]
     if lens_lamps:

@@ -45,7 +45,7 @@ def test_cloud_keys_are_read_with_defaults_and_written_back():
                  "albedo": 1.0, "g": pytest.approx(0.2), "erosion": pytest.approx(0.35),
                  "shape_scale": 8000.0, "detail_scale": 600.0, "wind": [0.0, 0.0], "time": 0.0, "seed": 0}
     q = scene["quality"]
-    assert (q["clouds"], q["cloud_steps"], q["cloud_light_steps"]) == ("adaptive", 96, 8)
+    assert (q["clouds"], q["cloud_steps"], q["cloud_light_steps"]) == ("adaptive", 96, 32)
     given_keys = {"base": 800, "top": 1200, "coverage": 1, "type": 0, "extinction": 0.2, "albedo": 0.9,
                   "g": 0.5, "erosion": 0.1, "shape_scale": 5000, "detail_scale": 300, "wind": [10, -5],
                   "time": 60, "seed": 7}
@@ -149,9 +149,32 @@ def test_clouds_darken_the_sky_behind_them_and_add_their_light(renderer):
     clear = renderer.render({**scene, "clouds": None}, outputs=["radiance", "transmittance"])
     t = out["transmittance"]
     assert t.min() < 0.5 and np.all(t <= clear["transmittance"] + 1e-6)
-    # Where the view ray misses the layer (the ground) nothing changes.
+    # Where the view ray misses the layer (the ground) the clouds add nothing and attenuate
+    # nothing; the ground is darker only where they shadow the sun.
     below = slice(SKY_SCENE["film"]["height"] * 3 // 4, None)
-    assert np.array_equal(out["radiance"][below], clear["radiance"][below])
+    assert np.all(out["clouds"][below] == 0.0)
+    assert np.array_equal(out["transmittance"][below], clear["transmittance"][below])
+    assert np.all(out["radiance"][below] <= clear["radiance"][below] * (1 + 1e-6))
+
+
+def test_clouds_shadow_the_ground_by_their_transmittance_toward_the_sun(renderer):
+    """A grey ground seen straight down: the sun's part of its light is multiplied by the clouds'
+    transmittance toward the sun (compared with a scene whose sun is off), so overcast shadows it
+    deeply, and no coverage not at all."""
+    def ground(coverage: float, sun: bool) -> float:
+        scene = with_clouds(coverage=coverage, type=0.0, extinction=0.2)
+        scene["camera"] = {"position": [0, 10, 0], "look_at": [0, 0, -0.01], "up": [0, 0, -1], "fov_y": 10}
+        scene["film"] = {"width": 4, "height": 4}
+        if not sun:
+            scene["sun"]["irradiance"] = 0
+        return float(renderer.render(scene).mean())
+    sky_only = ground(1.0, False)
+    assert ground(1.0, True) - sky_only < 1e-3 * (ground(1e-9, True) - ground(1e-9, False))
+    clear = with_clouds()
+    clear["clouds"] = None
+    clear["camera"] = {"position": [0, 10, 0], "look_at": [0, 0, -0.01], "up": [0, 0, -1], "fov_y": 10}
+    clear["film"] = {"width": 4, "height": 4}
+    assert ground(1e-9, True) == pytest.approx(float(renderer.render(clear).mean()), rel=1e-5)
 
 
 @pytest.mark.parametrize("method", ["adaptive", "march"])
@@ -170,7 +193,8 @@ def test_clouds_layer_and_the_others_sum_to_the_radiance(renderer, method):
 @given(data=st.data())
 def test_no_nan_inf_or_negative_radiance_over_wide_parameters(renderer_cache, data):
     """Camera below, inside, on the boundary or above the layer, looking anywhere; coverage and
-    extinction from 0 to their limits; the sun from below the horizon to the zenith."""
+    extinction from 0 to their limits; the sun from below the horizon to the zenith; with and
+    without a ground (a sky lighting clouds with no surface once crashed: its table was not built)."""
     draw = data.draw
     base = draw(st.floats(0, 5000))
     top = base + draw(st.sampled_from([1.0, 50.0, 2000.0, 8000.0]))
@@ -187,6 +211,10 @@ def test_no_nan_inf_or_negative_radiance_over_wide_parameters(renderer_cache, da
                        "fov_y": 60}
     scene["sun"] = {"elevation": draw(st.sampled_from([-5.0, 0.0, 0.5, 30.0, 90.0])), "azimuth": 20,
                     "irradiance": [12, 11.5, 10.5]}
+    if draw(st.booleans()):
+        del scene["surfaces"]  # no ground: the sky's light on the clouds needs its table all the same
+    if draw(st.booleans()):
+        scene["sky"] = {"model": "overcast", "zenith_radiance": 0.4}
     backend = draw(st.sampled_from(["cpu", "gl"]))
     out = renderer_cache(backend).render(scene, outputs=["radiance", "clouds"])
     for name in ("radiance", "clouds"):

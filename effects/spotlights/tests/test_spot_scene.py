@@ -30,7 +30,8 @@ SCENE: dict[str, Any] = {
     "surfaces": [{"type": "plane", "point": [0.0, 0.0, 0.0], "normal": [0.0, 1.0, 0.0]}],
 }
 
-SPOT_KEYS = {"type", "position", "direction", "intensity", "cone_angle", "edge", "radius"}
+SPOT_KEYS = {"type", "position", "direction", "intensity", "cone_angle", "edge", "radius",
+             "volumetric_shadows"}
 
 
 def _scene(*lights: dict[str, Any]) -> dict[str, Any]:
@@ -57,6 +58,7 @@ def test_spot_loads_normalised_with_defaults() -> None:
     assert spot["cone_angle"] == 25.0
     assert spot["edge"] == 0
     assert spot["radius"] == pytest.approx(0.05)
+    assert spot["volumetric_shadows"] is False
     assert "direction" not in loaded["lights"][0]
 
 
