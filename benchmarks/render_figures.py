@@ -152,10 +152,28 @@ def light_shafts_figure(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(rows[:-1], axis=0)).save(out)
 
 
+def clouds_figure(backend: str, out: Path) -> None:
+    """Each noise-clouds preset, with multiple scattering's octaves (left) and single scattering
+    (right), a row each."""
+    rows = []
+    with airlight.Renderer(backend) as r:
+        for name in ("clouds_cumulus_town", "clouds_flythrough", "clouds_sunset_above",
+                     "clouds_overcast_rain"):
+            tiles = []
+            for multiple in (True, False):
+                scene = airlight.preset(name)
+                scene.setdefault("quality", {})["multiple_scattering"] = multiple
+                tiles.append(airlight.display_scene(r.render(scene, width=320, height=180), scene))
+                tiles.append(np.full((tiles[-1].shape[0], 6, 3), 255, np.uint8))
+            rows.append(np.concatenate(tiles[:-1], axis=1))
+            rows.append(np.full((6, rows[-1].shape[1], 3), 255, np.uint8))
+    Image.fromarray(np.concatenate(rows[:-1], axis=0)).save(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
-    ap.add_argument("--only", choices=["rainbows", "daytime", "night", "shafts"],
+    ap.add_argument("--only", choices=["rainbows", "daytime", "night", "shafts", "clouds"],
                     help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
@@ -164,6 +182,9 @@ def main() -> None:
         return
     if args.only == "shafts":
         light_shafts_figure(args.backend, IMAGES / "light_shafts.png")
+        return
+    if args.only == "clouds":
+        clouds_figure(args.backend, IMAGES / "noise_clouds.png")
         return
     if args.only == "daytime":
         day_weather_strip(args.backend, IMAGES / "day_weather.png")
@@ -177,6 +198,7 @@ def main() -> None:
     day_weather_strip(args.backend, IMAGES / "day_weather.png")
     heavy_rain_before_after(args.backend, IMAGES / "heavy_rain_multiple_scattering.png")
     light_shafts_figure(args.backend, IMAGES / "light_shafts.png")
+    clouds_figure(args.backend, IMAGES / "noise_clouds.png")
     with airlight.Renderer(args.backend) as r:
         tiles = []
         for density in ("000", "001", "002", "004"):
