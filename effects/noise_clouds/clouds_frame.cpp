@@ -13,7 +13,8 @@ namespace {
 
 // Multiple scattering's octaves (physics.md eq. 6.1): each octave's weight,
 // optical-depth and asymmetry factors and their count, fitted to Mitsuba 3's
-// path tracer with a <= b (docs/multiple_scattering.md, docs/fit_octaves.txt:
+// path tracer with a <= b (effects/noise_clouds/docs/multiple_scattering.md,
+// effects/noise_clouds/docs/fit_octaves.txt:
 // median error 47 % where single scattering's is 90 %; thick clouds stay far
 // too dark).
 constexpr float OCTAVE_WEIGHT = 0.5434f;

@@ -9,10 +9,10 @@ Three parts:
 1. For each camera (below, inside and above the layer: the tests' scenes, single scattering), each
    setting of the adaptive march (`quality.cloud_steps`, `quality.cloud_light_steps`) and of the
    brute force (`quality.clouds: "march"`, `march_steps` equal steps, equal light steps): the frame
-   time at --width x --height on each backend, and the error of the clouds layer against the
-   float64 reference (tests/clouds_reference.py) at --error-width x --error-height on the CPU: the
-   median and 99th percentile of the relative error over the pixels above 1e-3 of the maximum (the
-   issue's measure). The speed-up at equal error is read off the table (and the plot).
+   time at --width x --height on each backend, and the error of the clouds layer against the float64
+   reference (effects/noise_clouds/tests/clouds_reference.py) at --error-width x --error-height on
+   the CPU: the median and 99th percentile of the relative error over the pixels above 1e-3 of the
+   maximum (the issue's measure). The speed-up at equal error is read off the table (and the plot).
 2. The noise textures: build time (a fresh process) and memory.
 3. What a scene without clouds pays: the same scene with `"clouds": null` against coverage 0
    (nothing built, no cloud code: HAS_CLOUDS off) and against the clouds.

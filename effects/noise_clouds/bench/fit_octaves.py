@@ -12,12 +12,14 @@ path tracer on the SAME density, and reports how far the fitted model and plain 
 are from the path tracer. The method, the settings and the result are written up in
 effects/noise_clouds/docs/multiple_scattering.md.
 
-1. Density grids. For each cloud case the reference density d(p) (tests/clouds_reference.py, the
-   renderer's noise textures of seed 0) is evaluated at the voxel centres of a box: BOX_WIDTH in x
-   and z around the origin, the support slab [base, base + t (top - base)] in y (d = 0 outside it),
-   voxels of about --voxel metres. sigma_t = extinction d, rounded to float32 (what Mitsuba holds);
-   both sides use that grid with trilinear interpolation between voxel centres, clamped to the
-   outermost centres at the faces (Mitsuba's gridvolume default), and 0 outside the box.
+1. Density grids. For each cloud case the reference density d(p)
+   (effects/noise_clouds/tests/clouds_reference.py, the renderer's noise textures of seed 0) is
+   evaluated at the voxel centres of a box: BOX_WIDTH in x and z around the origin, the support slab
+   [base, base + t (top - base)] in y (d = 0 outside it), voxels of about --voxel metres. sigma_t =
+   extinction d, rounded to float32 (what Mitsuba holds); both sides use that grid with trilinear
+   interpolation between voxel centres, clamped to the outermost centres at the faces (Mitsuba's
+   gridvolume default), and 0 outside the box.
+
 2. Mitsuba. ``volpath`` in ``llvm_ad_mono``: a ``cube`` with a ``null`` BSDF holding a
    ``heterogeneous`` medium (sigma_t the grid, albedo 1, ``hg`` phase g), a ``directional`` sun of
    irradiance 1, nothing else (no sky, black background, no ground). Rays from three cameras (below
@@ -843,7 +845,8 @@ def plot(path: str, data: Data, blocks: list[Block], chosen: dict) -> None:
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--quick", action="store_true", help="small run: two clouds, two suns, few rays, samples")
-    ap.add_argument("--out", default=None, help="text report (default docs/fit_octaves.txt; --quick: in the "
+    ap.add_argument("--out", default=None, help="text report (default "
+                    "effects/noise_clouds/docs/fit_octaves.txt; --quick: in the "
                     "temporary directory, so that a quick run leaves the documented result alone)")
     ap.add_argument("--plot", default=None, help="PNG (default beside --out's default)")
     ap.add_argument("--clouds", nargs="+", choices=list(CLOUDS), default=None)
