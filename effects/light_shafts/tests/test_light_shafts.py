@@ -181,11 +181,15 @@ def test_random_occluders_match_the_reference(renderer_cache, data):
     scene["medium"] = {"sigma_t": draw(st.floats(1e-4, 0.5)), "albedo": 1.0,
                        "phase": {"type": "hg", "g": draw(st.floats(-0.9, 0.9))}}
     scene["film"] = {"width": 32, "height": 18}
+    # The reference sees the sun as the renderer stores it (float32): a component like 1e-140 is
+    # 0 there, and a box face then lies exactly along the sunlight on both sides.
+    scene["sun"] = airlight.load_scene(scene)["sun"]
     ref = reference.medium_sun_radiance(scene, 32, 18)
     image = medium_sun(renderer_cache("cpu"), scene)
     assert np.all(np.isfinite(image))
-    if ref.max() == 0:
-        assert image.max() == 0
+    if ref.max() == 0:  # all shadowed: float32 run ends may leave a sliver lit, nothing more
+        unshadowed = medium_sun(renderer_cache("cpu"), {**scene, "quality": {"shafts": "off"}})
+        assert image.max() <= 1e-5 * unshadowed.max()
         return
     rel, mask = relative_errors(image, ref)
     where = worst_pixels(image, ref, mask)
