@@ -352,20 +352,8 @@ def _segments(grid: Grid, origins: np.ndarray, dirs: np.ndarray, t0: np.ndarray,
     length = np.maximum(t1 - t0, 0.0)
     counts = np.where(length > 0.0, np.maximum(1, np.ceil(length / step)), 0).astype(np.int64)
     dt_all = np.where(counts > 0, length / np.maximum(counts, 1), 0.0)
-    cum = np.cumsum(counts)
-    start = 0
     m = len(counts)
-    while start < m:
-        base = cum[start - 1] if start else 0
-        stop = max(int(np.searchsorted(cum, base + chunk, side="right")), start + 1)
-        rays = np.arange(start, stop)
-        n = counts[rays]
-        start = stop
-        total = int(n.sum())
-        if total == 0:
-            continue
-        ray = np.repeat(rays, n)
-        k = np.arange(total) - np.repeat(np.cumsum(n) - n, n)
+    for _rays, _n, ray, k in cr.sample_chunks(counts, chunk):
         dt = dt_all[ray]
         t = t0[ray] + (k + 0.5) * dt
         o = origins[ray] if origins.ndim == 2 and len(origins) == m else origins.reshape(-1, 3)[0]

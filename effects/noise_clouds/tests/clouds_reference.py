@@ -417,6 +417,25 @@ def transmittance_to_boundary(p: Any, w: Any, clouds: dict | CloudParams | None,
     return np.exp(-tau).reshape(p.shape[:-1])
 
 
+def sample_chunks(counts: np.ndarray, chunk: int):
+    """Splits the samples of rays with counts[i] samples each into chunks of about `chunk` samples
+    (whole rays): yields (rays, n, ray, k): the chunk's ray indices, their counts, each sample's
+    ray (global index) and its index k within its ray."""
+    cum = np.cumsum(counts)
+    start = 0
+    while start < len(counts):
+        base = cum[start - 1] if start else 0
+        stop = max(int(np.searchsorted(cum, base + chunk, side="right")), start + 1)
+        rays = np.arange(start, stop)
+        n = counts[rays]
+        start = stop
+        total = int(n.sum())
+        if total == 0:
+            continue
+        ray = np.repeat(rays, n)
+        yield rays, n, ray, np.arange(total) - np.repeat(np.cumsum(n) - n, n)
+
+
 def march_view(origin: Any, dirs: Any, t0: Any, t1: Any, sigma_fn: SigmaFn, source_fn: SourceFn | None,
                sigma_medium: Any = 0.0, steps: int = DEFAULT_STEPS,
                max_step: float | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -442,20 +461,9 @@ def march_view(origin: Any, dirs: Any, t0: Any, t1: Any, sigma_fn: SigmaFn, sour
         counts = np.where(length > 0.0, np.maximum(counts, np.ceil(length / max_step)), 0).astype(np.int64)
     radiance = np.zeros((nrays, 3))
     tau = np.zeros(nrays)
-    cum = np.cumsum(counts)
-    start = 0
-    while start < nrays:
-        base = cum[start - 1] if start else 0
-        stop = max(int(np.searchsorted(cum, base + _VIEW_CHUNK_SAMPLES, side="right")), start + 1)
-        rays = np.arange(start, stop)
-        n = counts[rays]
-        start = stop
-        total = int(n.sum())
-        if total == 0:
-            continue
-        ray = np.repeat(rays, n)  # each sample's ray (global index)
+    for rays, n, ray, k in sample_chunks(counts, _VIEW_CHUNK_SAMPLES):
+        total = len(ray)
         first = np.cumsum(n) - n  # each ray's first sample within the chunk
-        k = np.arange(total) - np.repeat(first, n)
         with np.errstate(divide="ignore", invalid="ignore"):
             dt_ray = np.where(n > 0, length[rays] / np.maximum(n, 1), 0.0)
         dt = dt_ray[ray - rays[0]]
