@@ -10,7 +10,7 @@ cd "$(dirname "$0")/.."
 
 packages=(g++ cmake ninja-build pkg-config python3 python3-dev python3-venv
           libegl-dev libopengl-dev libegl-mesa0 libgl1-mesa-dri libglm-dev nlohmann-json3-dev libeigen3-dev libglfw3-dev
-          libopenexr-dev clang-format)
+          libopenexr-dev libpng-dev clang-format)
 missing=()
 for p in "${packages[@]}"; do
     dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")

@@ -85,3 +85,18 @@ vec4 table_trilinear4_periodic(int table, int n, vec3 u) {
                    mix(table_texel4(table, i0, row11), table_texel4(table, i1, row11), a.x), a.y);
     return mix(near, far, a.z);
 }
+
+// Manual bilinear interpolation of a tiling nx x ny RGBA table at u in tile
+// units, texel (i, j) centred at ((i + 1/2) / nx, (j + 1/2) / ny), wrapping
+// (the clouds' weather map, effects/noise_clouds/physics.md eq. 8.1).
+vec4 table_bilinear4_periodic(int table, int nx, int ny, vec2 u) {
+    vec2 f = vec2(float(nx), float(ny)) * (u - floor(u)) - vec2(0.5f);
+    vec2 corner = floor(f);
+    vec2 a = f - corner;
+    int i0 = (int(corner.x) + nx) % nx;
+    int j0 = (int(corner.y) + ny) % ny;
+    int i1 = (i0 + 1) % nx;
+    int j1 = (j0 + 1) % ny;
+    return mix(mix(table_texel4(table, i0, j0), table_texel4(table, i1, j0), a.x),
+               mix(table_texel4(table, i0, j1), table_texel4(table, i1, j1), a.x), a.y);
+}

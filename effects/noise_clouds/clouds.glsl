@@ -37,11 +37,23 @@ float cloud_height_profile(float h, float type) {
 // so s_c = 0 means no cloud at p.
 float cloud_coverage_shape(vec3 p, float h) {
     vec3 u = p * frame.clouds.tiles.x - vec3(frame.clouds.offsets.x, 0.0f, frame.clouds.offsets.y);
+    float c = frame.clouds.density.x;
+    float type = frame.clouds.density.y;
+    if (CLOUDS_WEATHER_MAP) {
+        // Eq. 8.1: the map's R scales the coverage; its G is the type where the map has colour (B = 1).
+        vec2 uv = vec2(p.x, p.z) * vec2(frame.clouds.weather) - vec2(frame.clouds.weather.z, frame.clouds.weather.w);
+        vec4 w = table_bilinear4_periodic(TABLE_CLOUD_WEATHER, frame.clouds.weather_texels.x,
+                                          frame.clouds.weather_texels.y, uv);
+        c *= w.x;
+        type = mix(type, w.y, w.z);
+        if (!(c > 0.0f)) return 0.0f;
+    }
+    float profile = cloud_height_profile(h, type);
+    if (!(profile > 0.0f)) return 0.0f;
     vec4 s = table_trilinear4_periodic(TABLE_CLOUD_SHAPE, CLOUD_SHAPE_SIZE, u);
     float low = 0.625f * s.y + 0.25f * s.z + 0.125f * s.w;
     float shape = clamp((s.x - (low - 1.0f)) / (2.0f - low), 0.0f, 1.0f);
-    float s_h = shape * cloud_height_profile(h, frame.clouds.density.y);
-    float c = frame.clouds.density.x;
+    float s_h = shape * profile;
     return clamp((s_h - (1.0f - c)) / c, 0.0f, 1.0f) * c;
 }
 

@@ -6,6 +6,7 @@
 
 #include "frame_data.hpp"
 #include "noise.hpp"
+#include "weather_map.hpp"
 
 namespace airlight {
 
@@ -43,6 +44,15 @@ void pack_noise_clouds_frame(const Scene& scene, FrameData& data) {
     g.octaves = scene.quality.multiple_scattering
                     ? glm::vec4(OCTAVE_WEIGHT, OCTAVE_DEPTH, OCTAVE_ASYMMETRY, float(OCTAVE_COUNT))
                     : glm::vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    if (const WeatherMap& m = c.weather_map; m.texels) {
+        // The map's corner (centre - size / 2) drifts with the wind like the noise.
+        data.features.clouds_weather_map = true;
+        g.weather = glm::vec4(float(1.0 / double(m.size_x)), float(1.0 / double(m.size_z)),
+                              tile_fraction((double(m.center_x) - 0.5 * m.size_x + dx) / m.size_x),
+                              tile_fraction((double(m.center_z) - 0.5 * m.size_z + dz) / m.size_z));
+        g.weather_texels = glm::ivec4(m.texels->width, m.texels->height, 0, 0);
+        data.use_table(shader::TABLE_CLOUD_WEATHER, m.texels);
+    }
     const CloudNoise noise = cloud_noise_textures(c.seed);
     data.use_table(shader::TABLE_CLOUD_SHAPE, noise.shape);
     data.use_table(shader::TABLE_CLOUD_DETAIL, noise.detail);

@@ -2,9 +2,11 @@
 // "cloud_steps", "cloud_light_steps" (README "Scene format"; physics.md),
 // parsed and written back through the registry (EFFECT_SCENE_KEYS,
 // EFFECT_QUALITY_KEYS; cpp/scene_keys.hpp).
+#include <stdexcept>
 #include <string>
 
 #include "scene_keys.hpp"
+#include "weather_map.hpp"
 
 namespace airlight {
 
@@ -14,9 +16,34 @@ namespace {
 
 const NameTable<CloudsMethod> clouds_methods{{"adaptive", CloudsMethod::adaptive}, {"march", CloudsMethod::march}};
 
+// [a, b] (m) of a two-number array key.
+void read_pair(const Value& v, double lo, double hi, float& a, float& b) {
+    if (!v.j.is_array() || v.j.size() != 2) fail(Kind::type, v.field, "expected [x, z] (m), got " + type_name(v.j));
+    a = read_in_range(Value{v.j[0], index_path(v.field, 0)}, lo, hi, " m");
+    b = read_in_range(Value{v.j[1], index_path(v.field, 1)}, lo, hi, " m");
+}
+
+// "weather_map": {"image": path, "size": [x, z], "center": [x, z]}; the image is read here, so that a
+// missing or bad file is reported against the key.
+WeatherMap parse_weather_map(const SceneObject& o) {
+    o.check_keys({"image", "size", "center"});
+    WeatherMap m;
+    const Value image = o.req("image");
+    if (!image.j.is_string()) fail(Kind::type, image.field, "expected a file path, got " + type_name(image.j));
+    m.image = image.j.get<std::string>();
+    read_pair(o.req("size"), 1.0, 1e7, m.size_x, m.size_z);
+    if (auto v = o.opt("center")) read_pair(*v, -1e7, 1e7, m.center_x, m.center_z);
+    try {
+        m.texels = load_weather_map(m.image);
+    } catch (const std::runtime_error& e) {
+        fail(Kind::value, image.field, e.what());
+    }
+    return m;
+}
+
 Clouds parse_clouds(const SceneObject& o) {
     o.check_keys({"base", "top", "coverage", "type", "extinction", "albedo", "g", "erosion", "shape_scale",
-                  "detail_scale", "wind", "time", "seed"});
+                  "detail_scale", "wind", "time", "seed", "weather_map"});
     Clouds c;
     c.present = true;
     if (auto v = o.opt("base")) c.base = read_in_range(*v, 0.0, 1e5, " m");
@@ -42,13 +69,27 @@ Clouds parse_clouds(const SceneObject& o) {
     }
     if (auto v = o.opt("time")) c.time = read_in_range(*v, -1e7, 1e7, " s");
     if (auto v = o.opt("seed")) c.seed = read_int(*v, 0, 1 << 30);
+    if (auto v = o.opt("weather_map"); v && !v->j.is_null()) c.weather_map = parse_weather_map(SceneObject(*v));
     return c;
 }
 
 }  // namespace
 
+// Rain falls from the cloud base (physics.md section 7): an atmosphere's rain
+// without its own "top" reaches up to the layer's base. Runs after the daytime
+// effect has parsed the atmosphere (effects/registry.cmake).
 void parse_noise_clouds_keys(const SceneObject& top, Scene& s) {
-    if (auto v = top.opt("clouds"); v && !v->j.is_null()) s.clouds = parse_clouds(SceneObject(*v));
+    auto v = top.opt("clouds");
+    if (!v || v->j.is_null()) return;
+    s.clouds = parse_clouds(SceneObject(*v));
+    const json& atmosphere = top.j.contains("atmosphere") ? top.j["atmosphere"] : json();
+    const bool rain_top_given = atmosphere.is_object() && atmosphere.contains("rain") &&
+                                atmosphere["rain"].is_object() && atmosphere["rain"].contains("top");
+    if (!s.atmosphere.rain.present || rain_top_given) return;
+    if (!(s.clouds.base > 0.0f))
+        fail(Kind::value, "atmosphere.rain.top",
+             "missing: the rain would fall from the clouds' base, which is at the ground; give the rain a top");
+    s.atmosphere.rain.top = s.clouds.base;
 }
 
 void write_noise_clouds_keys(const Scene& s, json& j) {
@@ -70,6 +111,12 @@ void write_noise_clouds_keys(const Scene& s, json& j) {
                    {"wind", json::array({json_number(c.wind_x), json_number(c.wind_z)})},
                    {"time", json_number(c.time)},
                    {"seed", c.seed}};
+    if (c.weather_map.texels) {
+        const WeatherMap& m = c.weather_map;
+        j["clouds"]["weather_map"] = {{"image", m.image},
+                                      {"size", json::array({json_number(m.size_x), json_number(m.size_z)})},
+                                      {"center", json::array({json_number(m.center_x), json_number(m.center_z)})}};
+    }
 }
 
 void parse_noise_clouds_quality(const SceneObject& quality, Scene& s) {

@@ -14,4 +14,7 @@ struct CloudsGpu {
     vec4 density;   // x: coverage, y: type, z: erosion, w: albedo
     vec4 lighting;  // x: Henyey-Greenstein g, y: view steps across the layer, z: light steps, w: unused
     vec4 octaves;   // multiple scattering's octaves (physics.md eq. 6.1): x: a, y: b, z: c, w: their count (1: single)
+    vec4 weather;   // the weather map (CLOUDS_WEATHER_MAP; section 8): x, y: 1 / size along x, z (1/m),
+                    // z, w: fract(the map's corner + wind time, over the size) along x, z
+    ivec4 weather_texels;  // x, y: the map's width and height in texels, z, w: unused
 };

@@ -3,7 +3,23 @@
 // every field's meaning).
 #pragma once
 
+#include <memory>
+#include <string>
+
 namespace airlight {
+
+struct Table2D;
+
+// A weather map (physics.md section 8): an image laid over the ground, `size`
+// metres along x and z centred on `center`, repeating, drifting with the
+// wind: its red channel scales the coverage, its green channel (a colour
+// image) is the type (weather_map.hpp reads it).
+struct WeatherMap {
+    std::string image;  // the PNG or EXR file's path, as given
+    float size_x = 0.0f, size_z = 0.0f;
+    float center_x = 0.0f, center_z = 0.0f;
+    std::shared_ptr<const Table2D> texels;  // null: no weather map
+};
 
 // A layer of cloud between two altitudes whose density comes from two tiling
 // noise textures (physics.md sections 1 and 2).
@@ -11,8 +27,8 @@ struct Clouds {
     bool present = false;
     float base = 1500.0f;         // m: the layer's bottom (density 0 there)
     float top = 4000.0f;          // m: its top
-    float coverage = 0.5f;        // [0, 1]: the fraction of the sky the layer covers (0: none)
-    float type = 0.5f;            // [0, 1]: the height profile, 0 stratus, 0.5 cumulus, 1 cumulonimbus
+    float coverage = 0.5f;        // [0, 1]: the fraction of the sky the layer covers (0: none; x the weather map's R)
+    float type = 0.5f;            // [0, 1]: the height profile, 0 stratus, 0.5 cumulus, 1 cumulonimbus (or the map's G)
     float extinction = 0.05f;     // 1/m: sigma_t at density 1
     float albedo = 1.0f;          // single-scattering albedo (water droplets: 1)
     float g = 0.2f;               // Henyey-Greenstein asymmetry of the droplets' lobe
@@ -23,6 +39,7 @@ struct Clouds {
     float wind_z = 0.0f;          // m/s: along z
     float time = 0.0f;            // s: the field has drifted by wind * time
     int seed = 0;                 // the noise textures' seed
+    WeatherMap weather_map;       // optional: coverage and type varying over the ground
 };
 
 // Clouds that can be seen or cast shadows: some coverage and extinction (a

@@ -130,6 +130,62 @@ SourceFn = Callable[[np.ndarray, np.ndarray, np.ndarray], np.ndarray]
 # --------------------------------------------------------------------------------------------
 
 
+@dataclass(frozen=True, eq=False)
+class WeatherMap:
+    """The layer's weather map (physics.md section 8), read independently of the renderer (PIL for
+    PNG, the OpenEXR bindings for EXR): texels (rows, cols, 3) float64 of R the coverage factor,
+    G the type, B 1 where the image has colour; `size` and `center` (m) along x and z."""
+
+    image: str
+    texels: np.ndarray
+    size: tuple[float, float]
+    center: tuple[float, float] = (0.0, 0.0)
+
+    @classmethod
+    def from_dict(cls, m: dict) -> WeatherMap:
+        path = str(m["image"])
+        if path.lower().endswith(".exr"):
+            import OpenEXR
+
+            with OpenEXR.File(path) as f:
+                channels = f.channels()
+                if "RGB" in channels:
+                    rgb = np.asarray(channels["RGB"].pixels, dtype=np.float64)
+                    r, g, colour = rgb[..., 0], rgb[..., 1], True
+                else:
+                    r = np.asarray(next(iter(channels.values())).pixels, dtype=np.float64)
+                    g, colour = np.zeros_like(r), False
+        else:
+            from PIL import Image
+
+            with Image.open(path) as im:
+                colour = im.mode not in ("L", "LA", "I", "I;16", "1")
+                a = np.asarray(im.convert("RGB") if colour else im, dtype=np.float64)
+                scale = 65535.0 if im.mode.startswith("I") else 255.0
+            a = a / scale
+            r, g = (a[..., 0], a[..., 1]) if colour else (a, np.zeros_like(a))
+        texels = np.stack([r, g, np.full_like(r, 1.0 if colour else 0.0)], axis=-1)
+        size = (float(m["size"][0]), float(m["size"][1]))
+        center = (float(m["center"][0]), float(m["center"][1])) if "center" in m else (0.0, 0.0)
+        return cls(path, texels, size, center)
+
+    def sample(self, x: np.ndarray, z: np.ndarray) -> np.ndarray:
+        """(..., 3): the texels bilinear between their centres and repeating (eq. 8.1) at ground
+        points (x, z) of the still (wind-free) map."""
+        rows, cols, _ = self.texels.shape
+        u = (x - self.center[0]) / self.size[0] + 0.5
+        v = (z - self.center[1]) / self.size[1] + 0.5
+        fx = cols * (u - np.floor(u)) - 0.5
+        fy = rows * (v - np.floor(v)) - 0.5
+        i0, j0 = np.floor(fx), np.floor(fy)
+        ax, ay = (fx - i0)[..., None], (fy - j0)[..., None]
+        i0, j0 = i0.astype(np.int64) % cols, j0.astype(np.int64) % rows
+        i1, j1 = (i0 + 1) % cols, (j0 + 1) % rows
+        t = self.texels
+        return ((1 - ay) * ((1 - ax) * t[j0, i0] + ax * t[j0, i1])
+                + ay * ((1 - ax) * t[j1, i0] + ax * t[j1, i1]))
+
+
 @dataclass(frozen=True)
 class CloudParams:
     """The scene's `clouds` object with its defaults (README "Scene format"; physics.md)."""
@@ -147,6 +203,7 @@ class CloudParams:
     wind: tuple[float, float] = (0.0, 0.0)
     time: float = 0.0
     seed: int = 0
+    weather_map: WeatherMap | None = None
 
     @classmethod
     def from_dict(cls, clouds: dict) -> CloudParams:
@@ -154,7 +211,10 @@ class CloudParams:
         unknown = set(clouds) - known
         if unknown:
             raise ValueError(f"unknown clouds keys {sorted(unknown)}")
-        kw: dict[str, Any] = {k: float(v) for k, v in clouds.items() if k not in ("wind", "seed")}
+        special = ("wind", "seed", "weather_map")
+        kw: dict[str, Any] = {k: float(v) for k, v in clouds.items() if k not in special}
+        if clouds.get("weather_map") is not None:
+            kw["weather_map"] = WeatherMap.from_dict(clouds["weather_map"])
         if "wind" in clouds:
             vx, vz = clouds["wind"]
             kw["wind"] = (float(vx), float(vz))
@@ -177,8 +237,16 @@ class CloudParams:
     @property
     def support(self) -> tuple[float, float]:
         """(y_lo, y_hi): the slab outside which d = 0 identically (H = 0 at h <= 0 and h >= t)."""
-        t = profile_corners(self.type)[2]
+        t = profile_corners(self.highest_type)[2]
         return self.base, self.base + t * (self.top - self.base)
+
+    @property
+    def highest_type(self) -> float:
+        """The largest type anywhere (the profile's top rises with the type)."""
+        if self.weather_map is None:
+            return self.type
+        w = self.weather_map.texels
+        return float(np.max(w[..., 2] * w[..., 1] + (1.0 - w[..., 2]) * self.type))
 
 
 def cloud_params(clouds: dict | CloudParams | None) -> CloudParams:
@@ -261,19 +329,22 @@ def sample_periodic(tex: TextureLike, u: Any) -> np.ndarray:
 # --------------------------------------------------------------------------------------------
 
 
-def profile_corners(cloud_type: float) -> tuple[float, float, float]:
+def profile_corners(cloud_type: Any) -> tuple[Any, Any, Any]:
     """(a, b, t) of the height profile, linear in type between stratus (0), cumulus (0.5) and
-    cumulonimbus (1)."""
-    x = float(cloud_type)
-    if x < 0.5:
-        lo, hi, f = PROFILE_STRATUS, PROFILE_CUMULUS, 2.0 * x
-    else:
-        lo, hi, f = PROFILE_CUMULUS, PROFILE_CUMULONIMBUS, 2.0 * x - 1.0
-    a, b, t = (lo[i] + (hi[i] - lo[i]) * f for i in range(3))
-    return a, b, t
+    cumulonimbus (1); a float, or arrays for an array of types."""
+    x = np.asarray(cloud_type, dtype=np.float64)
+    lower = x < 0.5
+    f = np.where(lower, 2.0 * x, 2.0 * x - 1.0)
+    corners = []
+    for i in range(3):
+        lo = np.where(lower, PROFILE_STRATUS[i], PROFILE_CUMULUS[i])
+        hi = np.where(lower, PROFILE_CUMULUS[i], PROFILE_CUMULONIMBUS[i])
+        c = lo + (hi - lo) * f
+        corners.append(float(c) if c.ndim == 0 else c)
+    return corners[0], corners[1], corners[2]
 
 
-def height_profile(h: Any, cloud_type: float) -> np.ndarray:
+def height_profile(h: Any, cloud_type: Any) -> np.ndarray:
     """The trapezoid H(h, type): 0 at h <= 0, rising linearly to 1 at h = a, 1 up to h = b,
     falling linearly to 0 at h = t, 0 above: max(0, min(h / a, 1, (t - h) / (t - b)))."""
     a, b, t = profile_corners(cloud_type)
@@ -286,7 +357,7 @@ def density(p: Any, clouds: dict | CloudParams | None, shape: TextureLike, detai
 
     h = (p_y - base) / (top - base), q = p - o with o = (vx time, 0, vz time):
     (R, G, B, A) = shape(q / shape_scale), low = 0.625 G + 0.25 B + 0.125 A,
-    s = clamp((R - (low - 1)) / (2 - low), 0, 1), s_h = s H(h), c = coverage,
+    s = clamp((R - (low - 1)) / (2 - low), 0, 1), s_h = s H(h), c = coverage (x the weather map's R),
     s_c = clamp((s_h - (1 - c)) / c, 0, 1) c (0 at c = 0), (r, g, b, _) = detail(q / detail_scale),
     high = 0.625 r + 0.25 g + 0.125 b, m = mix(high, 1 - high, clamp(10 h, 0, 1)),
     d = clamp((s_c - e m) / (1 - e m), 0, 1). Zero where H = 0 (outside the layer included); the
@@ -298,14 +369,21 @@ def density(p: Any, clouds: dict | CloudParams | None, shape: TextureLike, detai
     lead = p.shape[:-1]
     x = p.reshape(-1, 3)
     out = np.zeros(len(x))
-    c = prm.coverage
-    if c <= 0.0 or len(x) == 0:
+    if prm.coverage <= 0.0 or len(x) == 0:
         return out.reshape(lead)
     h = (x[:, 1] - prm.base) / (prm.top - prm.base)
-    profile = height_profile(h, prm.type)
+    c: Any = prm.coverage
+    cloud_type: Any = prm.type
+    if prm.weather_map is not None:  # eq. 8.1, the map drifting with the wind
+        w = prm.weather_map.sample(x[:, 0] - prm.offset[0], x[:, 2] - prm.offset[2])
+        c = prm.coverage * w[:, 0]
+        cloud_type = w[:, 2] * w[:, 1] + (1.0 - w[:, 2]) * prm.type
+    profile = np.where(c > 0.0, height_profile(h, cloud_type), 0.0)
     idx = np.flatnonzero(profile > 0.0)
     if idx.size == 0:
         return out.reshape(lead)
+    if np.ndim(c):
+        c = c[idx]
     shape, detail = _texture(shape), _texture(detail)
     q = x[idx] - prm.offset
     r_low = _trilinear(shape.mixed(_SHAPE_R_LOW), shape.n, q / prm.shape_scale)

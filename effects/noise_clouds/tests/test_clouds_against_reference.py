@@ -96,3 +96,42 @@ def test_multiple_scattering_octaves_only_add_light(renderer_cache):
     multiple = renderer_cache("cpu").render(scene, outputs=["clouds"])["clouds"]
     assert np.all(multiple >= single * (1 - 1e-6))
     assert multiple.sum() > 1.05 * single.sum()
+
+
+@pytest.fixture(scope="module")
+def weather_map_png(tmp_path_factory) -> str:
+    """A 12 x 10 colour map: coverage rising along x from 0, the type along z from stratus to
+    cumulonimbus, and a clear hole."""
+    from PIL import Image
+
+    cols, rows = 12, 10
+    rgb = np.zeros((rows, cols, 3), np.uint8)
+    rgb[..., 0] = np.round(255 * np.linspace(0, 1, cols))[None, :]
+    rgb[..., 1] = np.round(255 * np.linspace(0, 1, rows))[:, None]
+    rgb[3:5, 6:8, 0] = 0
+    path = tmp_path_factory.mktemp("weather") / "map.png"
+    Image.fromarray(rgb).save(path)
+    return str(path)
+
+
+_map_references: dict[str, tuple[np.ndarray, np.ndarray]] = {}
+
+
+@pytest.mark.slow
+def test_weather_map_matches_the_float64_reference(renderer, weather_map_png):
+    """The reference reads the map itself (PIL) and interpolates it in float64 (eq. 8.1)."""
+    scene = scene_for("above")
+    scene["clouds"].update(coverage=1.0, weather_map={"image": weather_map_png, "size": [9000, 7000],
+                                                      "center": [500, -3000]})
+    if weather_map_png not in _map_references:
+        shape, detail = airlight._core.cloud_noise_textures(0)
+        _map_references[weather_map_png] = (ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail),
+                                            ref.clouds_transmittance(scene, WIDTH, HEIGHT, shape, detail))
+    light, through = _map_references[weather_map_png]
+    scene["quality"] = dict(ACCURATE)
+    out = renderer.render(scene, outputs=["clouds", "transmittance"])
+    rel, where = relative_errors(out["clouds"], light)
+    assert through.min() < 0.5 and through.max() > 0.9  # the map makes clear and covered parts
+    assert np.median(rel) <= 5e-3, where
+    assert np.percentile(rel, 99) <= 3e-2, where
+    np.testing.assert_allclose(out["transmittance"], through, rtol=2e-2, atol=2e-4)

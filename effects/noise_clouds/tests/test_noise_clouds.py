@@ -74,6 +74,19 @@ def test_bad_cloud_keys_name_the_field(clouds, field, error):
         airlight.load_scene({**SKY_SCENE, "clouds": clouds})
 
 
+def test_rain_falls_from_the_cloud_base_unless_given_a_top():
+    def rain_top(scene: dict[str, Any]) -> float:
+        return airlight.load_scene(scene)["atmosphere"]["rain"]["top"]
+
+    rain = {"atmosphere": {"rain": {"rate": 5}}}
+    assert rain_top({**with_clouds(base=900, top=3000), **rain}) == 900
+    given_top = {"atmosphere": {"rain": {"rate": 5, "top": 700}}}
+    assert rain_top({**with_clouds(base=900, top=3000), **given_top}) == 700
+    assert rain_top({**SKY_SCENE, "clouds": None, **rain}) == 1500  # the rain's own default
+    with pytest.raises(ValueError, match="atmosphere.rain.top"):
+        airlight.load_scene({**with_clouds(base=0, top=3000), **rain})
+
+
 def test_bad_cloud_quality_names_the_field():
     with pytest.raises(ValueError, match="quality.clouds"):
         airlight.load_scene({**SKY_SCENE, "quality": {"clouds": "fast"}})
@@ -125,6 +138,7 @@ def test_scene_without_visible_clouds_builds_no_noise(clouds):
 def test_scene_with_clouds_builds_both_noise_textures():
     built = tables_built_by(SKY_SCENE)
     assert {"cloud_shape", "cloud_detail"} <= set(built)
+    assert "cloud_weather" not in built  # no weather map given
 
 
 # ---- Rendering ---------------------------------------------------------------------------------
@@ -244,4 +258,92 @@ def test_wind_drift_is_the_field_shifted(renderer):
     still = with_clouds()
     a = renderer.render(still, outputs=["clouds"])["clouds"]
     b = renderer.render(moved, outputs=["clouds"])["clouds"]
+    assert np.abs(a - b).max() <= 1e-3 * a.max()
+
+
+# ---- Weather map (physics.md section 8) ------------------------------------------------------
+
+def write_png(path: Any, values: np.ndarray) -> str:
+    """values (rows, cols) or (rows, cols, 3) in [0, 1] as an 8-bit PNG (16-bit for a uint16 array)."""
+    from PIL import Image
+
+    if values.dtype == np.uint16:
+        Image.fromarray(values).save(path)  # mode I;16: a 16-bit grey PNG
+    else:
+        Image.fromarray(np.round(255 * values).astype(np.uint8)).save(path)
+    return str(path)
+
+
+def with_map(path: str, **clouds: Any) -> dict[str, Any]:
+    return with_clouds(**clouds, weather_map={"image": path, "size": [6000, 5000], "center": [100, -2000]})
+
+
+def test_weather_map_is_read_with_its_keys_and_written_back(tmp_path):
+    path = write_png(tmp_path / "map.png", np.full((4, 6, 3), 0.5))
+    scene = airlight.load_scene(with_map(path))
+    assert scene["clouds"]["weather_map"] == {"image": path, "size": [6000.0, 5000.0],
+                                              "center": [100.0, -2000.0]}
+    assert airlight.load_scene(scene) == scene
+    assert "cloud_weather" in airlight.table_stats()
+
+
+SIZE = [1000, 1000]
+
+
+@pytest.mark.parametrize("weather_map, field, error, message", [
+    ({"image": "no/such/map.png", "size": SIZE}, "clouds.weather_map.image", ValueError, "no such file"),
+    ({"image": 3, "size": SIZE}, "clouds.weather_map.image", TypeError, "file path"),
+    ({"image": "README.md", "size": SIZE}, "clouds.weather_map.image", ValueError, ".png or .exr"),
+    ({"image": "MAP", "size": [1000]}, "clouds.weather_map.size", TypeError, r"\[x, z\]"),
+    ({"image": "MAP", "size": [0, 1000]}, r"clouds.weather_map.size\[0\]", ValueError, ""),
+    ({"image": "MAP"}, "clouds.weather_map.size", ValueError, "missing"),
+    ({"image": "MAP", "size": SIZE, "centre": [0, 0]}, "clouds.weather_map.centre", ValueError, "center"),
+    ({"image": "TINY", "size": SIZE}, "clouds.weather_map.image", ValueError, "2 x 2"),
+    ({"image": "OUT_OF_RANGE", "size": SIZE}, "clouds.weather_map.image", ValueError, r"outside \[0, 1\]"),
+])
+def test_bad_weather_map_names_the_field(tmp_path, weather_map, field, error, message):
+    import OpenEXR
+
+    files = {"MAP": write_png(tmp_path / "map.png", np.ones((4, 4))),
+             "TINY": write_png(tmp_path / "tiny.png", np.ones((1, 4)))}
+    bad = np.ones((4, 4, 3), np.float32)
+    bad[2, 1, 0] = 1.5
+    files["OUT_OF_RANGE"] = str(tmp_path / "bad.exr")
+    OpenEXR.File({"compression": OpenEXR.ZIP_COMPRESSION, "type": OpenEXR.scanlineimage},
+                 {"RGB": bad}).write(files["OUT_OF_RANGE"])
+    weather_map = {**weather_map, "image": files.get(weather_map["image"], weather_map["image"])}
+    with pytest.raises(error, match=f"{field}.*{message}"):
+        airlight.load_scene(with_clouds(weather_map=weather_map))
+
+
+def test_uniform_weather_map_renders_as_its_values(renderer, tmp_path):
+    """A map of one colour is the layer's coverage scaled by R and the type G; a grey map keeps
+    the layer's type; 8-bit codes are code / 255 and 16-bit ones code / 65535 (data, no sRGB)."""
+    def clouds(scene: dict[str, Any]) -> np.ndarray:
+        return renderer.render(scene, outputs=["clouds"])["clouds"]
+
+    colour = write_png(tmp_path / "colour.png", np.full((8, 8, 3), [153 / 255, 51 / 255, 0.0]))
+    keyed = clouds(with_clouds(coverage=1.0 * 153 / 255, type=51 / 255))
+    assert keyed.max() > 1e-3
+    np.testing.assert_allclose(clouds(with_map(colour, coverage=1.0)), keyed, rtol=1e-4,
+                               atol=1e-6 * keyed.max())
+    grey16 = write_png(tmp_path / "grey16.png", np.full((8, 8), 39321, np.uint16))  # 0.6
+    keyed = clouds(with_clouds(coverage=0.5 * 0.6, type=0.8))
+    np.testing.assert_allclose(clouds(with_map(grey16, coverage=0.5, type=0.8)), keyed, rtol=1e-4,
+                               atol=1e-6 * keyed.max())
+    empty = write_png(tmp_path / "empty.png", np.zeros((8, 8, 3)))
+    assert not clouds(with_map(empty, coverage=1.0)).any()
+
+
+def test_weather_map_drifts_with_the_wind(renderer, tmp_path):
+    """The map moves with the noise: a camera moved by wind x time sees the same clouds."""
+    rng = np.random.default_rng(3)
+    path = write_png(tmp_path / "patchy.png", rng.uniform(0, 1, (6, 6, 3)))
+    shift = [400.0, 0.0, -250.0]
+    moved = with_map(path, wind=[4.0, -2.5], time=100.0)
+    for key in ("position", "look_at"):
+        moved["camera"][key] = [a + b for a, b in zip(moved["camera"][key], shift)]
+    a = renderer.render(with_map(path), outputs=["clouds"])["clouds"]
+    b = renderer.render(moved, outputs=["clouds"])["clouds"]
+    assert a.max() > 1e-3
     assert np.abs(a - b).max() <= 1e-3 * a.max()
