@@ -39,8 +39,9 @@ vec3 sky_escaping_radiance(vec3 dir) {
 // transmittance to each altitude), the sun's over the lit parts of the ray;
 // the light from beyond a reaches the camera through the homogeneous medium
 // before a. The clouds call it on the parts of the ray around their layer
-// (effects/noise_clouds/physics.md section 5).
-vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance) {
+// (effects/noise_clouds/physics.md section 5), the sun's light times
+// sun_scale, their transmittance toward the sun there (section 9; 1: none).
+vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance, float sun_scale) {
     if (!HAS_ATMOSPHERE || !(b > a)) return radiance;
     vec3 start = origin + a * dir;
     float length_ = b >= NO_HIT ? NO_HIT : b - a;
@@ -50,12 +51,12 @@ vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
     vec3 medium_sun;  // the homogeneous medium's sunlight (HAS_MEDIUM_SUN; effects/light_shafts)
     vec3 through_atmosphere;
     if (SKY_MARCH) {
-        atmosphere_scattering_march(start, dir, length_, sigma_medium, int(frame.march_steps), inscatter, rainbow,
-                                    medium_sun, through_atmosphere);
+        atmosphere_scattering_march(start, dir, length_, sigma_medium, int(frame.march_steps), sun_scale, inscatter,
+                                    rainbow, medium_sun, through_atmosphere);
     } else {
         // The sun's shadows along the ray (effects/light_shafts): counted by the volumes.
         sun_shadow_runs(start, dir, length_);
-        atmosphere_scattering(start, dir, length_, sigma_medium, true, inscatter, rainbow, medium_sun,
+        atmosphere_scattering(start, dir, length_, sigma_medium, true, sun_scale, inscatter, rainbow, medium_sun,
                               through_atmosphere);
     }
     if (a > 0.0f) {
@@ -75,5 +76,5 @@ vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
 // clouds, their transfer calls atmosphere_segment_transfer around their layer instead.
 vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (HAS_CLOUDS) return radiance;
-    return atmosphere_segment_transfer(origin, dir, 0.0f, t_hit, radiance);
+    return atmosphere_segment_transfer(origin, dir, 0.0f, t_hit, radiance, 1.0f);
 }

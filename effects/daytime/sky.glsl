@@ -445,9 +445,10 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // scatters the sun's light into `medium_sun`, but no sky light. The sun's
 // shares count only over the lit parts of each volume, the complement of the
 // shadowed runs (`shadowed`: those of shadow_runs, effects/light_shafts/physics.md
-// section 5; false: none).
-void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, OUT(vec3) inscatter,
-                           OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
+// section 5; false: none), times sun_scale (the clouds' transmittance toward
+// the sun over this part of the ray, effects/noise_clouds/physics.md section 9; 1: none).
+void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
+                           OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
     rainbow = vec3(0.0f);
     medium_sun = vec3(0.0f);
@@ -533,7 +534,8 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
                 vec2 run = shadow_runs.run[run_index];
                 if (run.x > lit_from) {
                     vec3 tau_to = stretch_optical_depth(y_a, y_piece, mu, run.x - s_a) + sigma_medium * (run.x - s_a);
-                    add_sun_part(weight, dtau, tau_from, tau_to, sun_a, sun_b, inscatter, rainbow, medium_sun);
+                    add_sun_part(weight * sun_scale, dtau, tau_from, tau_to, sun_a, sun_b, inscatter, rainbow,
+                                 medium_sun);
                 }
                 if (run.y >= s_b) {  // shadowed to the volume's end: the run may reach the next volume
                     lit_from = s_b;
@@ -545,7 +547,8 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
                 }
                 ++run_index;
             }
-            if (lit_from < s_b) add_sun_part(weight, dtau, tau_from, dtau, sun_a, sun_b, inscatter, rainbow, medium_sun);
+            if (lit_from < s_b)
+                add_sun_part(weight * sun_scale, dtau, tau_from, dtau, sun_a, sun_b, inscatter, rainbow, medium_sun);
         }
         weight *= exp(-dtau);
         transmittance *= exp(-tau);
@@ -563,7 +566,7 @@ vec3 atmosphere_transmittance(vec3 o, vec3 d, float s_end) {
     vec3 rainbow;
     vec3 medium_sun;
     vec3 t;
-    atmosphere_scattering(o, d, s_end, vec3(0.0f), false, inscatter, rainbow, medium_sun, t);
+    atmosphere_scattering(o, d, s_end, vec3(0.0f), false, 1.0f, inscatter, rainbow, medium_sun, t);
     return t;
 }
 
@@ -595,8 +598,8 @@ float march_far_distance(vec3 o, vec3 d, float s_in, float s_out, vec3 sigma_med
 // The same by brute force (benchmarks, SKY_MARCH): `steps` midpoint steps of
 // equal length over [s_in, s_far] (march_far_distance: rays end where they
 // have become opaque); transmittance accumulated step by step; the sun's
-// light at each step only where a shadow ray finds it (HAS_SHAFTS).
-void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium, int steps,
+// light at each step only where a shadow ray finds it (HAS_SHAFTS), times sun_scale.
+void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium, int steps, float sun_scale,
                                  OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun,
                                  OUT(vec3) transmittance) {
     inscatter = vec3(0.0f);
@@ -621,9 +624,10 @@ void atmosphere_scattering_march(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
         vec3 j;
         vec3 j_rainbow;
         SpeciesLight light = species_light(t, ms_dir, y, atmosphere_column(y), sun_phase);
-        if (HAS_SUN && sun_visible_from_air(o + s * d) == 0.0f) {
-            for (int i = 0; i < 3; ++i) light.sun[i] = vec3(0.0f);
-            light.medium_sun = vec3(0.0f);
+        if (HAS_SUN) {
+            float lit = sun_visible_from_air(o + s * d) * sun_scale;
+            for (int i = 0; i < 3; ++i) light.sun[i] *= lit;
+            light.medium_sun *= lit;
         }
         atmosphere_point(y, y, light, sigma, j, j_rainbow);
         vec3 reaching = exp(-(tau + sigma * (0.5f * ds)) - (tau_medium + sigma_medium * (float(step) + 0.5f) * ds));

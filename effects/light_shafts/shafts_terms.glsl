@@ -17,8 +17,9 @@ vec3 medium_sun_source(vec3 d) {
 // the lit parts of [a, b] (physics.md eq. 3.2), exact; or, with SHAFTS_MARCH,
 // a midpoint march of frame.march_steps steps with a shadow ray each, to b or
 // where e^{-sigma_t t} < e^{-30}. The clouds call it on the parts of the ray
-// around their layer (effects/noise_clouds/physics.md section 5).
-vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance) {
+// around their layer (effects/noise_clouds/physics.md section 5), the light
+// times sun_scale, their transmittance toward the sun there (section 9; 1: none).
+vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance, float sun_scale) {
     if (!HAS_MEDIUM_SUN || HAS_ATMOSPHERE || !(b > a)) return radiance;
     vec3 sigma = vec3(frame.sigma_t);
     vec3 light = vec3(0.0f);
@@ -44,7 +45,7 @@ vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
         }
         if (lit_from < b) light += attenuated_length(sigma, lit_from, b);
     }
-    light *= medium_sun_source(dir);
+    light *= sun_scale * medium_sun_source(dir);
     layer_add(LAYER_MEDIUM_SUN, light);
     return radiance + light;
 }
@@ -54,5 +55,5 @@ vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
 // medium_sun_segment_transfer around their layer instead.
 vec3 medium_sun_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (HAS_CLOUDS) return radiance;
-    return medium_sun_segment_transfer(origin, dir, 0.0f, t_hit, radiance);
+    return medium_sun_segment_transfer(origin, dir, 0.0f, t_hit, radiance, 1.0f);
 }

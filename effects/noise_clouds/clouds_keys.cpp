@@ -1,5 +1,5 @@
 // The noise clouds' scene key "clouds" and quality keys "clouds",
-// "cloud_steps", "cloud_light_steps" (README "Scene format"; physics.md),
+// "cloud_steps", "cloud_light_steps", "cloud_shadow_steps" (README "Scene format"; physics.md),
 // parsed and written back through the registry (EFFECT_SCENE_KEYS,
 // EFFECT_QUALITY_KEYS; cpp/scene_keys.hpp).
 #include <stdexcept>
@@ -123,12 +123,14 @@ void parse_noise_clouds_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("clouds")) s.quality.clouds = read_enum(*v, "clouds", clouds_methods);
     if (auto v = quality.opt("cloud_steps")) s.quality.cloud_steps = read_int(*v, 4, 4096);
     if (auto v = quality.opt("cloud_light_steps")) s.quality.cloud_light_steps = read_int(*v, 1, 1024);
+    if (auto v = quality.opt("cloud_shadow_steps")) s.quality.cloud_shadow_steps = read_int(*v, 0, 1024);
 }
 
 void write_noise_clouds_quality(const Scene& s, json& quality) {
     quality["clouds"] = name_of(clouds_methods, s.quality.clouds);
     quality["cloud_steps"] = s.quality.cloud_steps;
     quality["cloud_light_steps"] = s.quality.cloud_light_steps;
+    quality["cloud_shadow_steps"] = s.quality.cloud_shadow_steps;
 }
 
 }  // namespace airlight

@@ -12,7 +12,8 @@ struct CloudsGpu {
     vec4 tiles;     // x: 1 / shape_scale, y: 1 / detail_scale (tiles per metre), z, w: unused
     vec4 offsets;   // the wind's drift in tile units, fract(wind time / scale): x, y shape (along x, z), z, w detail
     vec4 density;   // x: coverage, y: type, z: erosion, w: albedo
-    vec4 lighting;  // x: Henyey-Greenstein g, y: view steps across the layer, z: light steps, w: unused
+    vec4 lighting;  // x: Henyey-Greenstein g, y: view steps across the layer, z: light steps,
+                    // w: pieces of the air in the clouds' shadow (quality.cloud_shadow_steps; 0: unshadowed)
     vec4 octaves;   // multiple scattering's octaves (physics.md eq. 6.1): x: a, y: b, z: c, w: their count (1: single)
     vec4 weather;   // the weather map (CLOUDS_WEATHER_MAP; section 8): x, y: 1 / size along x, z (1/m),
                     // z, w: fract(the map's corner + wind time, over the size) along x, z

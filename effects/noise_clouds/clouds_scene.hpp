@@ -54,8 +54,9 @@ enum class CloudsMethod {
 // The noise clouds' quality settings (a base of Quality).
 struct CloudsQuality {
     CloudsMethod clouds = CloudsMethod::adaptive;
-    int cloud_steps = 96;        // view-ray steps across the layer's thickness near the camera
-    int cloud_light_steps = 32;  // steps of each march toward the sun and upward (eq. 3.2)
+    int cloud_steps = 96;         // view-ray steps across the layer's thickness near the camera
+    int cloud_light_steps = 32;   // steps of each march toward the sun and upward (eq. 3.2)
+    int cloud_shadow_steps = 16;  // pieces of the air outside the layer lit through it (section 9; 0: unshadowed)
 };
 
 }  // namespace airlight

@@ -24,6 +24,6 @@ set(EFFECT_UNIFORMS "CloudsGpu clouds")
 set(EFFECT_SCENE_HEADER clouds_scene.hpp)
 set(EFFECT_SCENE_MEMBERS "Clouds clouds")
 set(EFFECT_QUALITY CloudsQuality)
-set(EFFECT_QUALITY_KEYS clouds cloud_steps cloud_light_steps)
+set(EFFECT_QUALITY_KEYS clouds cloud_steps cloud_light_steps cloud_shadow_steps)
 set(EFFECT_LAYERS
     "clouds=the sun's and the sky's light scattered once toward the camera by the cloud layer")

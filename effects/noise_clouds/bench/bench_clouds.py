@@ -4,7 +4,7 @@
         [--error-width 48 --error-height 27] [--frames 1] [--backends cpu gl]
         [--out effects/noise_clouds/docs/bench_clouds.txt] [--plot effects/noise_clouds/docs/bench_clouds.png]
 
-Three parts:
+Four parts (--parts to choose):
 
 1. For each camera (below, inside and above the layer: the tests' scenes, single scattering), each
    setting of the adaptive march (`quality.cloud_steps`, `quality.cloud_light_steps`) and of the
@@ -16,6 +16,10 @@ Three parts:
 2. The noise textures: build time (a fresh process) and memory.
 3. What a scene without clouds pays: the same scene with `"clouds": null` against coverage 0
    (nothing built, no cloud code: HAS_CLOUDS off) and against the clouds.
+4. The clouds' shadow in the air (physics.md section 9), for each `quality.cloud_shadow_steps`: the
+   error of the fraction of the fog's sunlight the clouds let through against the float64 reference
+   (the tests' fog scene at 24x14, CPU: median and maximum absolute error) and the frame time of
+   the preset clouds_cumulus_town (atmosphere, default quality otherwise) at --width x --height.
 
 Absolute times on a shared 2-core machine are noisy; compare ratios. GL is Mesa's llvmpipe; its
 loop limiter cuts long marches, whose pixels the renderer recomputes on the CPU.
@@ -76,6 +80,38 @@ print(json.dumps({"seconds": time.perf_counter() - t, "bytes": shape.nbytes + de
 """
 
 
+SHADOW_STEPS = [0, 4, 16, 64]
+
+
+def shadow_in_the_air(args: argparse.Namespace, renderers: dict[str, airlight.Renderer],
+                      cpu: airlight.Renderer, shape: np.ndarray, detail: np.ndarray) -> list[str]:
+    """Part 4: the error and cost of the clouds' shadow in the air by quality.cloud_shadow_steps."""
+    fog = cases.FOG_UNDER_CLOUDS
+    width, height = fog["film"]["width"], fog["film"]["height"]
+    through = clouds_reference.medium_sun_through_clouds(fog, width, height, shape, detail, steps=1024,
+                                                         light_steps=96)
+    town = airlight.preset("clouds_cumulus_town")
+    town["film"] = {"width": args.width, "height": args.height}
+    lines = ["", f"4. the clouds' shadow in the air: error of the fraction of the fog's sunlight let through "
+             f"({width}x{height}, CPU; reference from {np.nanmin(through):.2f} to {np.nanmax(through):.2f}); "
+             f"frame time of clouds_cumulus_town at {args.width}x{args.height}",
+             f"{'pieces':>6} {'median err':>11} {'max err':>9} "
+             + " ".join(f"{b + ' ms':>10}" for b in renderers)]
+    for steps in SHADOW_STEPS:
+        scene = copy.deepcopy(fog)
+        scene["quality"] = {"cloud_shadow_steps": steps, "cloud_light_steps": 96}
+        shadowed = cpu.render(scene, outputs=["medium_sun"])["medium_sun"][..., 1]
+        scene["quality"]["cloud_shadow_steps"] = 0
+        free = cpu.render(scene, outputs=["medium_sun"])["medium_sun"][..., 1]
+        err = np.abs(shadowed / free - through)
+        town["quality"] = {**town.get("quality", {}), "cloud_shadow_steps": steps}
+        times = {b: frame_time(r, town, args.frames) for b, r in renderers.items()}
+        lines.append(f"{steps:6d} {np.median(err):11.2e} {np.max(err):9.2e} "
+                     + " ".join(f"{1e3 * times[b]:10.1f}" for b in renderers))
+        print(lines[-1], file=sys.stderr)
+    return lines
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--width", type=int, default=160)
@@ -87,17 +123,19 @@ def main() -> None:
     ap.add_argument("--backends", nargs="+", default=airlight.available_backends())
     ap.add_argument("--out", default=None, help="also write the tables to this file")
     ap.add_argument("--plot", default=None, help="write a plot of time against error (PNG)")
+    ap.add_argument("--parts", type=int, nargs="+", default=[1, 2, 3, 4], help="which parts to run")
     args = ap.parse_args()
 
     shape, detail = airlight._core.cloud_noise_textures(0)
-    lines = [f"1. frame time at {args.width}x{args.height} (median of {args.frames}); error of the clouds "
-             f"layer at {args.error_width}x{args.error_height} against the float64 reference (CPU)",
-             f"{'camera':8} {'method':>9} {'steps':>6} {'light':>6} {'median err':>11} {'p99 err':>9} "
-             + " ".join(f"{b + ' ms':>10}" for b in args.backends)]
+    lines = [] if 1 not in args.parts else [
+        f"1. frame time at {args.width}x{args.height} (median of {args.frames}); error of the clouds "
+        f"layer at {args.error_width}x{args.error_height} against the float64 reference (CPU)",
+        f"{'camera':8} {'method':>9} {'steps':>6} {'light':>6} {'median err':>11} {'p99 err':>9} "
+        + " ".join(f"{b + ' ms':>10}" for b in args.backends)]
     points: dict[str, list[tuple[float, float, str]]] = {}
     cpu = airlight.Renderer("cpu")
     renderers = {b: (cpu if b == "cpu" else airlight.Renderer(b)) for b in args.backends}
-    for camera in args.cameras:
+    for camera in args.cameras if 1 in args.parts else []:
         scene = cases.scene_for(camera)
         small = copy.deepcopy(scene)
         small["film"] = {"width": args.error_width, "height": args.error_height}
@@ -122,22 +160,27 @@ def main() -> None:
                         (times[b], p99, f"{steps}/{light}"))
                 print(lines[-1], file=sys.stderr)
 
-    build = json.loads(subprocess.run([sys.executable, "-c", BUILD], capture_output=True, text=True,
-                                      check=True).stdout)
-    lines += ["", "2. the noise textures (seed 11, a fresh process)",
-              f"build {build['seconds']:.2f} s, {build['bytes'] / 2**20:.1f} MiB "
-              "(128^3 and 32^3 RGBA float32)"]
+    if 2 in args.parts:
+        build = json.loads(subprocess.run([sys.executable, "-c", BUILD], capture_output=True, text=True,
+                                          check=True).stdout)
+        lines += ["", "2. the noise textures (seed 11, a fresh process)",
+                  f"build {build['seconds']:.2f} s, {build['bytes'] / 2**20:.1f} MiB "
+                  "(128^3 and 32^3 RGBA float32)"]
 
-    lines += ["", f"3. what clouds cost ({args.width}x{args.height}, camera below, default quality)",
-              f"{'backend':8} {'no clouds':>10} {'coverage 0':>11} {'clouds':>10}"]
-    base = cases.scene_for("below")
-    base["film"] = {"width": args.width, "height": args.height}
-    base["surfaces"] = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 0.2}]
-    for b, r in renderers.items():
-        none = frame_time(r, {**base, "clouds": None}, args.frames)
-        zero = frame_time(r, {**base, "clouds": {**base["clouds"], "coverage": 0}}, args.frames)
-        full = frame_time(r, base, args.frames)
-        lines.append(f"{b:8} {1e3 * none:10.1f} {1e3 * zero:11.1f} {1e3 * full:10.1f}")
+    if 3 in args.parts:
+        lines += ["", f"3. what clouds cost ({args.width}x{args.height}, camera below, default quality)",
+                  f"{'backend':8} {'no clouds':>10} {'coverage 0':>11} {'clouds':>10}"]
+        base = cases.scene_for("below")
+        base["film"] = {"width": args.width, "height": args.height}
+        base["surfaces"] = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 0.2}]
+        for b, r in renderers.items():
+            none = frame_time(r, {**base, "clouds": None}, args.frames)
+            zero = frame_time(r, {**base, "clouds": {**base["clouds"], "coverage": 0}}, args.frames)
+            full = frame_time(r, base, args.frames)
+            lines.append(f"{b:8} {1e3 * none:10.1f} {1e3 * zero:11.1f} {1e3 * full:10.1f}")
+
+    if 4 in args.parts:
+        lines += shadow_in_the_air(args, renderers, cpu, shape, detail)
 
     text = "\n".join(lines)
     print(text)

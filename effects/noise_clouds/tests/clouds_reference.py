@@ -723,3 +723,30 @@ def clouds_transmittance(scene: Any, width: int, height: int, shape: TextureLike
             path = np.where(sig_m[None, :] > 0.0, np.outer(t_end, sig_m), 0.0)
         out *= np.exp(-path).reshape(height, width, 3)
     return out
+
+
+def medium_sun_through_clouds(scene: Any, width: int, height: int, shape: TextureLike, detail: TextureLike,
+                              steps: int = 2048, light_steps: int = DEFAULT_LIGHT_STEPS) -> np.ndarray:
+    """(H, W): the fraction of the homogeneous medium's sunlight below the layer that the clouds
+    let through (physics.md section 9), for a camera below the layer's base:
+    int_0^t0 e^{-sigma t} T_c(o + t d, s) dt / int_0^t0 e^{-sigma t} dt, t0 where the ray meets the
+    base (or its first surface, or CLOUD_VIEW_FAR); `steps` equal steps, each weighted exactly by
+    its e^{-sigma t} and lit at its middle. Needs a grey medium (sigma_t one number) and a sun; NaN
+    for rays that do not go up."""
+    prm = cloud_params(scene["clouds"])
+    origin, dirs, t_end = view_rays(scene, width, height)
+    sigma = float(medium_sigma_t(scene)[0])
+    s, _ = sun_light(scene)
+    if origin[1] >= prm.base:
+        raise ValueError("the camera must be below the layer")
+    up = dirs[:, 1] > 0.0
+    t0 = np.where(up, (prm.base - origin[1]) / np.where(up, dirs[:, 1], 1.0), 0.0)
+    t0 = np.minimum(np.minimum(t0, t_end), 200000.0)
+    edges = t0[:, None] * (np.arange(steps + 1) / steps)[None, :]
+    weight = np.exp(-sigma * edges[:, :-1]) - np.exp(-sigma * edges[:, 1:])
+    mid = 0.5 * (edges[:, :-1] + edges[:, 1:])
+    points = origin + mid[..., None] * dirs[:, None, :]
+    lit = transmittance_to_boundary(points.reshape(-1, 3), s, prm, shape, detail, light_steps)
+    lit = lit.reshape(mid.shape)
+    out = np.sum(weight * lit, axis=1) / np.maximum(np.sum(weight, axis=1), 1e-300)
+    return np.where(up, out, np.nan).reshape(height, width)
