@@ -222,10 +222,13 @@ void cloud_step(vec3 origin, vec3 dir, float t_mid, float dt, float density, INO
 // The clouds along [t0, t1] of the view ray (inside the layer): the light they
 // scatter toward the camera (attenuated by the clouds and the homogeneous
 // medium before it) and their transmittance, by the march of physics.md
-// section 4.
-void cloud_march(vec3 origin, vec3 dir, float t0, float t1, OUT(vec3) light, OUT(float) through_clouds) {
+// section 4; t_half, where their transmittance from t0 first falls below 1/2
+// (t1 if it never does: where the other media of the layer split, section 5).
+void cloud_march(vec3 origin, vec3 dir, float t0, float t1, OUT(vec3) light, OUT(float) through_clouds,
+                 OUT(float) t_half) {
     light = vec3(0.0f);
     through_clouds = 1.0f;
+    t_half = t1;
     if (CLOUDS_MARCH) {
         int steps = int(frame.march_steps);
         float dt = (t1 - t0) / float(steps);
@@ -233,6 +236,7 @@ void cloud_march(vec3 origin, vec3 dir, float t0, float t1, OUT(vec3) light, OUT
             float t = t0 + (float(k) + 0.5f) * dt;
             float density = cloud_density(origin + t * dir);
             if (density > 0.0f) cloud_step(origin, dir, t, dt, density, through_clouds, light);
+            if (t_half == t1 && through_clouds < 0.5f) t_half = t + 0.5f * dt;
         }
         return;
     }
@@ -257,6 +261,7 @@ void cloud_march(vec3 origin, vec3 dir, float t0, float t1, OUT(vec3) light, OUT
             float tk = t + (float(k) + 0.5f) * fine_step;
             float density = cloud_density(origin + tk * dir);
             if (density > 0.0f) cloud_step(origin, dir, tk, fine_step, density, through_clouds, light);
+            if (t_half == t1 && through_clouds < 0.5f) t_half = tk + 0.5f * fine_step;
         }
         t += long_step;
     }

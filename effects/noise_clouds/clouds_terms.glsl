@@ -50,9 +50,11 @@ vec3 cloud_shadowed_media_transfer(vec3 origin, vec3 dir, float a, float b, vec3
 
 // Hook view_transfer: with clouds, the media along [0, t_hit] composed around
 // the layer's part [t0, t1] of the ray (physics.md section 5): the other media
-// behind it, the clouds (their light in the `clouds` layer), the other media
-// in front, those outside the layer in its shadow (section 9). The
-// homogeneous medium's own transmittance was applied by the integrator; it
+// behind the layer, those of the layer's part behind t_half (where the
+// clouds' transmittance falls below 1/2), the clouds (their light in the
+// `clouds` layer), the other media of the layer's part in front of t_half,
+// those in front of the layer; all of them in the clouds' shadow (section 9).
+// The homogeneous medium's own transmittance was applied by the integrator; it
 // attenuates the clouds' light from the camera on.
 vec3 clouds_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_CLOUDS) return radiance;
@@ -60,12 +62,15 @@ vec3 clouds_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     float t1;
     if (!cloud_layer_interval(origin, dir, t_hit, t0, t1))
         return cloud_shadowed_media_transfer(origin, dir, 0.0f, t_hit, radiance);
-    radiance = cloud_shadowed_media_transfer(origin, dir, t1, t_hit, radiance);
     vec3 light;
     float through_clouds;
-    cloud_march(origin, dir, t0, t1, light, through_clouds);
+    float t_half;
+    cloud_march(origin, dir, t0, t1, light, through_clouds, t_half);
+    radiance = cloud_shadowed_media_transfer(origin, dir, t1, t_hit, radiance);
+    radiance = cloud_shadowed_media_transfer(origin, dir, t_half, t1, radiance);
     outputs_attenuate(vec3(through_clouds));
     layer_add(LAYER_CLOUDS, light);
     radiance = radiance * through_clouds + light;
+    radiance = cloud_shadowed_media_transfer(origin, dir, t0, t_half, radiance);
     return cloud_shadowed_media_transfer(origin, dir, 0.0f, t0, radiance);
 }
