@@ -1,8 +1,7 @@
 """Noise clouds against Mitsuba 3's path tracer at equal error: the sun's single scattering.
 
     .venv/bin/python effects/noise_clouds/bench/bench_mitsuba.py [--width 640 --height 360]
-        [--out effects/noise_clouds/docs/bench_mitsuba.txt]
-        [--plot effects/noise_clouds/docs/bench_mitsuba.png]
+        [--out TXT] [--plot PNG]
 
 The tests' scene with the camera below the layer (effects/noise_clouds/tests/
 test_clouds_against_reference.py), lit by the sun alone (irradiance 1, no sky), single scattering.
