@@ -1,7 +1,8 @@
 """Noise clouds against Mitsuba 3's path tracer at equal error: the sun's single scattering.
 
     .venv/bin/python effects/noise_clouds/bench/bench_mitsuba.py [--width 640 --height 360]
-        [--out TXT] [--plot PNG]
+        [--out effects/noise_clouds/docs/bench_mitsuba.txt]
+        [--plot effects/noise_clouds/docs/bench_mitsuba.png]
 
 The tests' scene with the camera below the layer (effects/noise_clouds/tests/
 test_clouds_against_reference.py), lit by the sun alone (irradiance 1, no sky), single scattering.
@@ -199,7 +200,8 @@ def main() -> None:
     lines += ["", f"Mitsuba's median error = {k_med:.3g} spp^-1/2, p99 = {k_p99:.3g} spp^-1/2 (fitted to its "
               f"runs); {sec_per_spp:.3g} s per sample per {args.width}x{args.height} frame. Its errors fall "
               f"as spp^{slopes[0]:.2f} (median) and spp^{slopes[1]:.2f} (p99) over these runs: where that is "
-              "slower than spp^-0.5 (heavy tails), the samples it needs, and the ratios, are lower bounds.",
+              "slower than spp^-0.5 (heavy tails) the samples it needs, and the ratios, are underestimated, "
+              "where faster overestimated.",
               "",
               "check of the setup (Mitsuba against the grid's float64 integral; heavy-tailed samples make "
               "the standard errors, and so the z-scores, unreliable at low counts):"]
