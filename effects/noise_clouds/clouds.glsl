@@ -138,21 +138,37 @@ float cloud_transmittance_from(vec3 p, vec3 w) {
     return exp(-cloud_optical_depth_toward(p, w));
 }
 
+// The droplets' phase function (physics.md eq. 3.4): Henyey-Greenstein of g,
+// mixed with a second lobe of frame.clouds.phase.x by its weight phase.y,
+// both asymmetries scaled by g_scale (the octaves' c^i).
+float cloud_phase(float mu, float g_scale) {
+    float first = species_phase(vec4(g_scale * frame.clouds.lighting.x, 0.0f, 1.0f, 0.0f), mu);
+    float w = frame.clouds.phase.y;
+    if (w == 0.0f) return first;
+    return mix(first, species_phase(vec4(g_scale * frame.clouds.phase.x, 0.0f, 1.0f, 0.0f), mu), w);
+}
+
 // Multiple scattering's octaves (eq. 6.1) for the sun: sum over i of a^i
-// e^{-b^i depth} p_HG(mu, c^i g); octave 0 alone is single scattering.
+// e^{-b^i depth} p(mu, c^i g); octave 0 alone is single scattering.
 float cloud_sun_octaves(float depth, float mu) {
     vec4 oct = frame.clouds.octaves;
     float sum = 0.0f;
     float weight = 1.0f;
     float depth_scale = 1.0f;
-    float g = frame.clouds.lighting.x;
+    float g_scale = 1.0f;
     for (int i = 0; i < int(oct.w); ++i) {
-        sum += weight * exp(-depth_scale * depth) * species_phase(vec4(g, 0.0f, 1.0f, 0.0f), mu);
+        sum += weight * exp(-depth_scale * depth) * cloud_phase(mu, g_scale);
         weight *= oct.x;
         depth_scale *= oct.y;
-        g *= oct.z;
+        g_scale *= oct.z;
     }
     return sum;
+}
+
+// The powder term (eq. 3.5): 1 - strength e^{-2 depth}, at most 1, so that
+// cloud_source_bound's value without it stays a bound.
+float cloud_powder(float depth) {
+    return 1.0f - frame.clouds.phase.z * exp(-2.0f * depth);
 }
 
 // The same for the sky's light (no phase: its mean over the hemisphere).
@@ -177,7 +193,8 @@ vec3 cloud_source_function(vec3 p, vec3 d) {
     vec3 source = vec3(0.0f);
     if (HAS_SUN) {
         vec3 s = vec3(frame.sky.sun_direction);
-        source += sun_irradiance(p, s) * cloud_sun_octaves(cloud_optical_depth_toward(p, s), dot(s, d));
+        float depth = cloud_optical_depth_toward(p, s);
+        source += sun_irradiance(p, s) * (cloud_sun_octaves(depth, dot(s, d)) * cloud_powder(depth));
     }
     if (HAS_SKY) {
         vec3 up = vec3(0.0f, 1.0f, 0.0f);

@@ -40,6 +40,7 @@ void pack_noise_clouds_frame(const Scene& scene, FrameData& data) {
     g.offsets = glm::vec4(tile_fraction(dx / c.shape_scale), tile_fraction(dz / c.shape_scale),
                           tile_fraction(dx / c.detail_scale), tile_fraction(dz / c.detail_scale));
     g.density = glm::vec4(c.coverage, c.type, c.erosion, c.albedo);
+    g.phase = glm::vec4(c.second_g, c.second_weight, c.powder, 0.0f);
     g.lighting = glm::vec4(c.g, float(scene.quality.cloud_steps), float(scene.quality.cloud_light_steps),
                            float(scene.quality.cloud_shadow_steps));
     g.octaves = scene.quality.multiple_scattering

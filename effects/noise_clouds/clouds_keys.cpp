@@ -42,8 +42,8 @@ WeatherMap parse_weather_map(const SceneObject& o) {
 }
 
 Clouds parse_clouds(const SceneObject& o) {
-    o.check_keys({"base", "top", "coverage", "type", "extinction", "albedo", "g", "erosion", "shape_scale",
-                  "detail_scale", "wind", "time", "seed", "weather_map"});
+    o.check_keys({"base", "top", "coverage", "type", "extinction", "albedo", "g", "second_g", "second_weight", "powder",
+                  "erosion", "shape_scale", "detail_scale", "wind", "time", "seed", "weather_map"});
     Clouds c;
     c.present = true;
     if (auto v = o.opt("base")) c.base = read_in_range(*v, 0.0, 1e5, " m");
@@ -58,6 +58,9 @@ Clouds parse_clouds(const SceneObject& o) {
     if (auto v = o.opt("extinction")) c.extinction = read_in_range(*v, 0.0, 1e3, " 1/m");
     if (auto v = o.opt("albedo")) c.albedo = read_in_range(*v, 0.0, 1.0);
     if (auto v = o.opt("g")) c.g = read_asymmetry(*v);
+    if (auto v = o.opt("second_g")) c.second_g = read_asymmetry(*v);
+    if (auto v = o.opt("second_weight")) c.second_weight = read_in_range(*v, 0.0, 1.0);
+    if (auto v = o.opt("powder")) c.powder = read_in_range(*v, 0.0, 1.0);
     if (auto v = o.opt("erosion")) c.erosion = read_in_range(*v, 0.0, 0.95);
     if (auto v = o.opt("shape_scale")) c.shape_scale = read_in_range(*v, 1.0, 1e7, " m");
     if (auto v = o.opt("detail_scale")) c.detail_scale = read_in_range(*v, 0.1, 1e7, " m");
@@ -105,6 +108,9 @@ void write_noise_clouds_keys(const Scene& s, json& j) {
                    {"extinction", json_number(c.extinction)},
                    {"albedo", json_number(c.albedo)},
                    {"g", json_number(c.g)},
+                   {"second_g", json_number(c.second_g)},
+                   {"second_weight", json_number(c.second_weight)},
+                   {"powder", json_number(c.powder)},
                    {"erosion", json_number(c.erosion)},
                    {"shape_scale", json_number(c.shape_scale)},
                    {"detail_scale", json_number(c.detail_scale)},

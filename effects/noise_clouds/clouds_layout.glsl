@@ -18,4 +18,5 @@ struct CloudsGpu {
     vec4 weather;   // the weather map (CLOUDS_WEATHER_MAP; section 8): x, y: 1 / size along x, z (1/m),
                     // z, w: fract(the map's corner + wind time, over the size) along x, z
     ivec4 weather_texels;  // x, y: the map's width and height in texels, z, w: unused
+    vec4 phase;     // x: the second lobe's g, y: its weight (eq. 3.4), z: the powder term's strength (eq. 3.5), w: unused
 };

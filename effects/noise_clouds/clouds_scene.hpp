@@ -32,6 +32,9 @@ struct Clouds {
     float extinction = 0.05f;     // 1/m: sigma_t at density 1
     float albedo = 1.0f;          // single-scattering albedo (water droplets: 1)
     float g = 0.2f;               // Henyey-Greenstein asymmetry of the droplets' lobe
+    float second_g = -0.3f;       // an optional second lobe's asymmetry (physics.md eq. 3.4)
+    float second_weight = 0.0f;   // [0, 1]: that lobe's share of the phase function (0: one lobe)
+    float powder = 0.0f;          // [0, 1]: the powder term's strength (eq. 3.5; 0: physical)
     float erosion = 0.35f;        // [0, 1]: how far the detail noise eats into the edges (eq. 2.4)
     float shape_scale = 8000.0f;  // m: the shape texture's tile
     float detail_scale = 600.0f;  // m: the detail texture's tile

@@ -197,6 +197,9 @@ class CloudParams:
     extinction: float = 0.05
     albedo: float = 1.0
     g: float = 0.2
+    second_g: float = -0.3
+    second_weight: float = 0.0
+    powder: float = 0.0
     erosion: float = 0.35
     shape_scale: float = 8000.0
     detail_scale: float = 600.0
@@ -639,9 +642,11 @@ def view_rays(scene: dict, width: int, height: int) -> tuple[np.ndarray, np.ndar
 def layer_radiance_with(scene: Any, width: int, height: int, sigma_fn: SigmaFn, slab: tuple[float, float],
                         albedo: float = 1.0, g: float = 0.2, steps: int = DEFAULT_STEPS,
                         light_steps: int = DEFAULT_LIGHT_STEPS, max_step: float | None = None,
-                        far: float = FAR) -> tuple[np.ndarray, np.ndarray]:
+                        far: float = FAR, second_g: float = -0.3, second_weight: float = 0.0,
+                        powder: float = 0.0) -> tuple[np.ndarray, np.ndarray]:
     """``clouds_layer_radiance`` for any cloud extinction sigma_fn (zero outside `slab` = (y_lo,
-    y_hi)), albedo and g: the scene gives the camera, surfaces, medium, sun and sky.
+    y_hi)), albedo, g, the second lobe (eq. 3.4) and the powder term (eq. 3.5): the scene gives
+    the camera, surfaces, medium, sun and sky.
 
     Returns (radiance (H, W, 3), clouds' optical depth tau (H, W)) along [t_in, t_out], the view
     ray's part in the slab within [0, min(t_end, far)]."""
@@ -652,14 +657,15 @@ def layer_radiance_with(scene: Any, width: int, height: int, sigma_fn: SigmaFn, 
     s, e_sun = sun_light(scene)
     e_sky = sky_irradiance(scene)
     sig_m = medium_sigma_t(scene)
-    phase = hg_phase(dirs @ s, g)
+    phase = (1.0 - second_weight) * hg_phase(dirs @ s, g) + second_weight * hg_phase(dirs @ s, second_g)
     up = np.array([0.0, 1.0, 0.0])
     use_sun, use_sky = bool(e_sun.any()), bool(e_sky.any())
 
     def source(x: np.ndarray, ray: np.ndarray, sig: np.ndarray) -> np.ndarray:
         j = np.zeros((len(x), 3))
         if use_sun:
-            t_sun = np.exp(-optical_depth_march(x, s, sigma_fn, y_lo, y_hi, light_steps, far))
+            tau_sun = optical_depth_march(x, s, sigma_fn, y_lo, y_hi, light_steps, far)
+            t_sun = np.exp(-tau_sun) * (1.0 - powder * np.exp(-2.0 * tau_sun))
             j += np.outer(t_sun * phase[ray], e_sun)
         if use_sky:
             t_up = np.exp(-optical_depth_march(x, up, sigma_fn, y_lo, y_hi, light_steps, far))
@@ -688,7 +694,8 @@ def clouds_layer_radiance(scene: Any, width: int, height: int, shape: TextureLik
         return np.zeros((height, width, 3))
     prm = cloud_params(scene["clouds"])
     radiance, _ = layer_radiance_with(scene, width, height, _sigma_function(prm, shape, detail), prm.support,
-                                      prm.albedo, prm.g, steps, light_steps, max_step, far)
+                                      prm.albedo, prm.g, steps, light_steps, max_step, far, prm.second_g,
+                                      prm.second_weight, prm.powder)
     return radiance
 
 

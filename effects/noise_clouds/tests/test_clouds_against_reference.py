@@ -175,3 +175,22 @@ def test_clouds_shadow_the_fog_below_them_like_the_float64_reference(renderer):
     # 0.00065, max 0.0022 (the reference's fraction runs from about 0.38 to 0.72).
     assert errors[16][0] <= 0.005 and errors[16][1] <= 0.03, errors
     assert errors[128][0] <= 0.002 and errors[128][1] <= 0.006, errors
+
+
+@pytest.mark.slow
+def test_second_lobe_and_powder_match_the_float64_reference(renderer):
+    """The options of physics.md eqs. 3.4 (a backward second lobe) and 3.5 (the powder term),
+    seen from above the layer with the sun behind the camera, where both matter."""
+    scene = scene_for("above")
+    scene["clouds"].update(second_g=-0.5, second_weight=0.3, powder=0.8)
+    scene["sun"] = {"elevation": 40, "azimuth": 180, "irradiance": [12, 11.5, 10.5]}
+    shape, detail = airlight._core.cloud_noise_textures(0)
+    light = ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail)
+    plain = copy.deepcopy(scene)
+    plain["clouds"].update(second_weight=0.0, powder=0.0)
+    plain_light = ref.clouds_layer_radiance(plain, WIDTH, HEIGHT, shape, detail)
+    assert np.abs(light - plain_light).max() > 0.1 * plain_light.max()  # the options change the image
+    scene["quality"] = dict(ACCURATE)
+    rel, where = relative_errors(renderer.render(scene, outputs=["clouds"])["clouds"], light)
+    assert np.median(rel) <= 5e-3, where
+    assert np.percentile(rel, 99) <= 3e-2, where

@@ -42,13 +42,15 @@ def test_cloud_keys_are_read_with_defaults_and_written_back():
     scene = airlight.load_scene({**SKY_SCENE, "clouds": {}})
     c = scene["clouds"]
     assert c == {"base": 1500.0, "top": 4000.0, "coverage": 0.5, "type": 0.5, "extinction": 0.05,
-                 "albedo": 1.0, "g": pytest.approx(0.2), "erosion": pytest.approx(0.35),
+                 "albedo": 1.0, "g": pytest.approx(0.2), "second_g": pytest.approx(-0.3),
+                 "second_weight": 0.0, "powder": 0.0, "erosion": pytest.approx(0.35),
                  "shape_scale": 8000.0, "detail_scale": 600.0, "wind": [0.0, 0.0], "time": 0.0, "seed": 0}
     q = scene["quality"]
     assert (q["clouds"], q["cloud_steps"], q["cloud_light_steps"]) == ("adaptive", 96, 32)
     assert q["cloud_shadow_steps"] == 16
     given_keys = {"base": 800, "top": 1200, "coverage": 1, "type": 0, "extinction": 0.2, "albedo": 0.9,
-                  "g": 0.5, "erosion": 0.1, "shape_scale": 5000, "detail_scale": 300, "wind": [10, -5],
+                  "g": 0.5, "second_g": -0.4, "second_weight": 0.25, "powder": 0.5, "erosion": 0.1,
+                  "shape_scale": 5000, "detail_scale": 300, "wind": [10, -5],
                   "time": 60, "seed": 7}
     again = airlight.load_scene({**SKY_SCENE, "clouds": given_keys,
                                  "quality": {"clouds": "march", "cloud_steps": 200, "cloud_light_steps": 3,
@@ -69,6 +71,9 @@ def test_cloud_keys_are_read_with_defaults_and_written_back():
     ({"wind": [1, "x"]}, "clouds.wind[1]", TypeError),
     ({"seed": 1.5}, "clouds.seed", ValueError),
     ({"g": 1}, "clouds.g", ValueError),
+    ({"second_g": -1}, "clouds.second_g", ValueError),
+    ({"second_weight": 1.5}, "clouds.second_weight", ValueError),
+    ({"powder": -0.1}, "clouds.powder", ValueError),
     ({"colour": 1}, "clouds.colour", ValueError),
 ])
 def test_bad_cloud_keys_name_the_field(clouds, field, error):
