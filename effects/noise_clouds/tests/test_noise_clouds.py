@@ -257,7 +257,10 @@ def test_no_nan_inf_or_negative_radiance_over_wide_parameters(renderer_cache, da
     scene = with_clouds(base=base, top=top, coverage=draw(st.sampled_from([0.0, 0.3, 1.0])),
                         extinction=draw(st.sampled_from([0.0, 1e-4, 0.05, 1e3])),
                         type=draw(st.floats(0, 1)), g=draw(st.floats(-0.9, 0.9)),
-                        wind=[draw(st.floats(-50, 50)), 0.0], time=draw(st.floats(0, 1e5)))
+                        wind=[draw(st.floats(-50, 50)), 0.0], time=draw(st.floats(0, 1e5)),
+                        second_g=draw(st.floats(-0.9, 0.9)),
+                        second_weight=draw(st.sampled_from([0.0, 0.5, 1.0])),
+                        powder=draw(st.sampled_from([0.0, 1.0])))
     scene["film"] = {"width": 12, "height": 8}
     scene["camera"] = {"position": [0.0, y, 0.0], "look_at": [look[0], y + look[1], look[2]], "up": [0, 1, 0],
                        "fov_y": 60}
