@@ -29,6 +29,10 @@ def test_sigint_interrupts_a_long_render_and_the_renderer_stays_usable(backend):
     skip_unless_backend_available(backend)
     script = textwrap.dedent(f"""
         import os, signal, threading, airlight
+        # Python's own Ctrl-C handler, also when the test runs where SIGINT is ignored (a job
+        # started in the background by a non-interactive shell inherits SIG_IGN, and Python then
+        # installs none: the render would finish).
+        signal.signal(signal.SIGINT, signal.default_int_handler)
         scene = airlight.load_scene("scenes/default.json")
         r = airlight.Renderer("{backend}")
         threading.Timer(1.0, lambda: os.kill(os.getpid(), signal.SIGINT)).start()
