@@ -557,6 +557,8 @@ def road_spot_scenes(draw: Any) -> dict:
     cam_height = 10.0 ** draw(st.floats(-1.5, 1.0))
     cam = [draw(st.floats(-3, 3)), cam_height, draw(st.floats(-3, 3)) + 3.0]
     target = [draw(st.floats(-2, 2)), 0.0, draw(st.floats(-2, 2))]
+    if math.hypot(cam[0] - target[0], cam[2] - target[2]) < 1e-3 * cam_height:
+        target[2] -= 0.1 * cam_height  # straight down is parallel to the camera's up: an invalid scene
     road = plane((0, 0, 0), (0, 1, 0), draw(st.floats(0.0, 1.0)))
     fov_y = draw(st.floats(10.0, 120.0))
     cull = draw(st.sampled_from([0.0, None]))
