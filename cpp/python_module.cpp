@@ -29,6 +29,7 @@
 #include "rainbow.hpp"
 #include "scene_json.hpp"
 #include "sky.hpp"
+#include "sphere_scattering.hpp"
 #include "spot_tables.hpp"
 #include "tables.hpp"
 
@@ -469,6 +470,84 @@ PYBIND11_MODULE(_core, m) {
             return py::make_tuple(as_array(*noise.shape), as_array(*noise.detail));
         },
         py::arg("seed"));
+    // The particle clouds' reference particle (effects/particle_clouds/sphere_scattering.hpp): the
+    // radiance of each scattering order along rays (origins and dirs (n, 3); the camera looks along dir)
+    // for a unit sphere of optical radius tau lit by a sun of irradiance 1 from direction `sun`, solved
+    // on `grid` (a dict of SphereGrid's fields); an (n, orders) float64 array.
+    m.def(
+        "particle_sphere_radiance",
+        [](double tau, double g, std::array<double, 3> sun,
+           py::array_t<double, py::array::c_style | py::array::forcecast> origins,
+           py::array_t<double, py::array::c_style | py::array::forcecast> dirs, py::dict grid_keys, int steps) {
+            airlight::SphereGrid grid;
+            for (auto item : grid_keys) {
+                const std::string key = py::str(item.first);
+                int* field = key == "radii"         ? &grid.radii
+                             : key == "polar"       ? &grid.polar
+                             : key == "zenith"      ? &grid.zenith
+                             : key == "azimuth"     ? &grid.azimuth
+                             : key == "march_steps" ? &grid.march_steps
+                             : key == "orders"      ? &grid.orders
+                                                    : nullptr;
+                if (!field) throw py::value_error("grid." + key + ": unknown key");
+                *field = item.second.cast<int>();
+            }
+            try {
+                airlight::validate_sphere_grid(grid);
+            } catch (const std::invalid_argument& e) {
+                throw py::value_error(e.what());
+            }
+            if (steps < 1 || steps > 1 << 16) throw py::value_error("steps: must be in [1, 65536]");
+            if (origins.ndim() != 2 || origins.shape(1) != 3 || dirs.ndim() != 2 || dirs.shape(1) != 3 ||
+                dirs.shape(0) != origins.shape(0))
+                throw py::value_error("origins, dirs: must both be (n, 3) arrays");
+            const double norm = std::sqrt(sun[0] * sun[0] + sun[1] * sun[1] + sun[2] * sun[2]);
+            if (!(norm > 0.0) || !std::isfinite(norm)) throw py::value_error("sun: must be a nonzero finite vector");
+            // The solver's frame: e1, e2, sun (its +z).
+            const std::array<double, 3> s{sun[0] / norm, sun[1] / norm, sun[2] / norm};
+            std::array<double, 3> e1 =
+                std::fabs(s[0]) < 0.9 ? std::array<double, 3>{1, 0, 0} : std::array<double, 3>{0, 1, 0};
+            const double proj = e1[0] * s[0] + e1[1] * s[1] + e1[2] * s[2];
+            for (int i = 0; i < 3; ++i) e1[i] -= proj * s[i];
+            const double n1 = std::sqrt(e1[0] * e1[0] + e1[1] * e1[1] + e1[2] * e1[2]);
+            for (double& x : e1) x /= n1;
+            const std::array<double, 3> e2{s[1] * e1[2] - s[2] * e1[1], s[2] * e1[0] - s[0] * e1[2],
+                                           s[0] * e1[1] - s[1] * e1[0]};
+            auto to_frame = [&](const double* x, double* out) {
+                out[0] = x[0] * e1[0] + x[1] * e1[1] + x[2] * e1[2];
+                out[1] = x[0] * e2[0] + x[1] * e2[1] + x[2] * e2[2];
+                out[2] = x[0] * s[0] + x[1] * s[1] + x[2] * s[2];
+            };
+            std::unique_ptr<airlight::SphereScattering> solved;
+            {
+                py::gil_scoped_release release;
+                try {
+                    solved = std::make_unique<airlight::SphereScattering>(tau, g, grid);
+                } catch (const std::invalid_argument& e) {
+                    py::gil_scoped_acquire acquire;
+                    throw py::value_error(e.what());
+                }
+            }
+            const py::ssize_t n = origins.shape(0);
+            py::array_t<double> out({n, py::ssize_t(grid.orders)});
+            const double* o = origins.data();
+            const double* d = dirs.data();
+            double* r = out.mutable_data();
+            for (py::ssize_t i = 0; i < n; ++i) {
+                double oo[3], dd[3];
+                to_frame(o + 3 * i, oo);
+                to_frame(d + 3 * i, dd);
+                const double len = std::sqrt(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
+                if (!(len > 0.0) || !std::isfinite(len))
+                    throw py::value_error("dirs: every row must be a nonzero finite vector");
+                for (double& x : dd) x /= len;
+                const std::vector<double> orders = solved->radiance_orders(oo, dd, steps);
+                std::copy(orders.begin(), orders.end(), r + i * grid.orders);
+            }
+            return out;
+        },
+        py::arg("tau"), py::arg("g"), py::arg("sun"), py::arg("origins"), py::arg("dirs"), py::arg("grid") = py::dict(),
+        py::arg("steps") = 256);
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

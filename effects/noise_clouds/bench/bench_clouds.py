@@ -1,6 +1,7 @@
 """Noise clouds: the adaptive march against fixed-step marching, time and error, both backends.
 
     .venv/bin/python effects/noise_clouds/bench/bench_clouds.py [--width 160 --height 90]
+        [--adaptive 96/32 200/64] [--march 1024/32 2048/64]
         [--error-width 48 --error-height 27] [--frames 1] [--backends cpu gl]
         [--out effects/noise_clouds/docs/bench_clouds.txt] [--plot effects/noise_clouds/docs/bench_clouds.png]
 
@@ -130,6 +131,10 @@ def main() -> None:
     ap.add_argument("--out", default=None, help="also write the tables to this file")
     ap.add_argument("--plot", default=None, help="write a plot of time against error (PNG)")
     ap.add_argument("--parts", type=int, nargs="+", default=[1, 2, 3, 4], help="which parts to run")
+    ap.add_argument("--adaptive", nargs="+", default=[f"{view}/{light}" for view, light in ADAPTIVE],
+                    help="part 1's adaptive settings, view/light steps")
+    ap.add_argument("--march", nargs="+", default=[f"{view}/{light}" for view, light in MARCH],
+                    help="part 1's fixed-step settings, view/light steps")
     args = ap.parse_args()
 
     shape, detail = airlight._core.cloud_noise_textures(0)
@@ -149,8 +154,8 @@ def main() -> None:
         exact = clouds_reference.clouds_layer_radiance(small, args.error_width, args.error_height, shape,
                                                        detail)
         print(f"{camera}: reference in {time.perf_counter() - t0:.0f} s", file=sys.stderr)
-        for method, table in (("adaptive", ADAPTIVE), ("march", MARCH)):
-            for steps, light in table:
+        for method, table in (("adaptive", args.adaptive), ("march", args.march)):
+            for steps, light in (map(int, pair.split("/")) for pair in table):
                 quality = settings(method, steps, light)
                 small["quality"] = quality
                 med, p99 = error_stats(cpu.render(small, outputs=["clouds"])["clouds"], exact)

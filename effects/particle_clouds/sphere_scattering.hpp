@@ -1,0 +1,52 @@
+// Light scattered inside the particle clouds' reference particle: a
+// homogeneous unit sphere of optical radius tau (albedo 1, Henyey-Greenstein
+// phase g) lit by the sun, solved order by order by iterating single
+// scattering (effects/particle_clouds/physics.md section 2). The frame puts
+// the sun on +z: sunlight travels along -z with irradiance 1.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+namespace airlight {
+
+// How finely the light field inside the sphere is resolved (physics.md
+// section 2.3; the defaults are chosen in effects/particle_clouds/docs/).
+struct SphereGrid {
+    int radii = 16;        // radial nodes, graded toward the surface in optical depth (eq. 2.7)
+    int polar = 32;        // the position's angle from the sun's axis, [0, pi]
+    int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
+    int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
+    int march_steps = 32;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
+    int orders = 18;       // scattering orders solved (the source sums 18)
+};
+
+// Throws std::invalid_argument naming the field when a resolution is out of range.
+void validate_sphere_grid(const SphereGrid& grid);
+
+// The solved light field of one sphere: the source function of every order
+// >= 2 on the grid (order 1 is analytic, eq. 2.2).
+class SphereScattering {
+public:
+    // Solves orders 1..grid.orders (about grid.orders - 1 gathers and marches).
+    // tau in [1e-4, 1e3], g in [0, 0.99].
+    SphereScattering(double tau, double g, const SphereGrid& grid = {});
+    ~SphereScattering();
+    SphereScattering(const SphereScattering&) = delete;
+    SphereScattering& operator=(const SphereScattering&) = delete;
+
+    // The radiance of each order 1..orders that a camera looking along `dir`
+    // (unit) from `origin` receives from the sphere (0 for a ray that misses
+    // it), the ray integral taken with `steps` steps (eq. 2.4).
+    std::vector<double> radiance_orders(const double origin[3], const double dir[3], int steps) const;
+
+    double tau() const;
+    double g() const;
+    const SphereGrid& grid() const;
+
+private:
+    struct Impl;
+    std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace airlight
