@@ -38,7 +38,7 @@ struct RadialMap {
     double a = 0.0;  // 0: uniform
 
     RadialMap(int nodes, double tau) : n(nodes) {
-        const double uniform = 1.0 / (n - 1), first = std::min(0.25 / tau, 0.35 * uniform);
+        const double uniform = 1.0 / (n - 1), first = std::min(0.05 / tau, 0.35 * uniform);
         if (first >= uniform) return;
         double lo = 1e-9, hi = 400.0;  // expm1(a / (n - 1)) / expm1(a) falls with a
         for (int it = 0; it < 200; ++it) {
@@ -215,59 +215,82 @@ struct SphereScattering::Impl {
         return std::fabs(l) < 1e-3 ? 0.5 * (a + b) * (1.0 - l * l / 12.0) : (b - a) / l;
     }
 
-    // Eq. 2.5's quadrature: W[i][j] = integral of p(v_i . w) times node j's hat function over the sphere
-    // of directions w, taken on 8 x 8 sub-cells of every cell (both signs of the azimuth), each row then
-    // scaled to sum to 1 (the phase function's normalisation, so that no order gains or loses energy).
-    // Stored transposed: gather_weights[j * dirs + i].
-    std::vector<float> gather_weights() const {
+    // The fraction of the light that a ray from radius r at zenith angle zeta (from the outward normal)
+    // meets inside the sphere: U = 1 - e^{-tau d(r, zeta)} (eq. 2.10).
+    double meets(double r, double zeta) const {
+        return -std::expm1(-tau * exit_distance(Vec{0.0, 0.0, r}, Vec{std::sin(zeta), 0.0, std::cos(zeta)}));
+    }
+
+    // Eq. 2.5's and 2.10's quadratures, stored transposed ([j * dirs + i]): plain[i][j] is the integral of
+    // p(v_i . w) times node j's hat function (bilinear in zeta and |psi|) over the sphere of directions;
+    // by_radius[radius][i][j] the same with the factor U(r, zeta(w)) inside. Both are taken on 8 x 8
+    // sub-cells of every cell with their exact solid angles (both signs of the azimuth), and each row of
+    // both is divided by plain's row sum, the phase function's normalisation, so that the discrete gather
+    // neither creates nor destroys light.
+    struct GatherWeights {
+        std::vector<float> plain, by_radius;
+    };
+    GatherWeights gather_weights() const {
         constexpr int kSub = 8;
-        struct Sample {
-            double cz, sz, az, solid;
-            int corner[4];
-            double weight[4];
-        };
-        std::vector<Sample> samples;
-        for (int k = 0; k + 1 < grid.zenith; ++k)
-            for (int l = 0; l + 1 < grid.azimuth; ++l)
-                for (int a = 0; a < kSub; ++a)
-                    for (int c = 0; c < kSub; ++c) {
-                        const double z0 = zenith_angle(k) + (zenith_angle(k + 1) - zenith_angle(k)) * a / kSub;
-                        const double z1 = zenith_angle(k) + (zenith_angle(k + 1) - zenith_angle(k)) * (a + 1) / kSub;
-                        const double fz = (a + 0.5) / kSub, fa = (c + 0.5) / kSub;
-                        const double ze = 0.5 * (z0 + z1);
-                        const double az = azimuth_angle(l) + (azimuth_angle(l + 1) - azimuth_angle(l)) * fa;
-                        Sample s{std::cos(ze),
-                                 std::sin(ze),
-                                 az,
-                                 (std::cos(z0) - std::cos(z1)) * (azimuth_angle(l + 1) - azimuth_angle(l)) / kSub,
-                                 {k * grid.azimuth + l, k * grid.azimuth + l + 1, (k + 1) * grid.azimuth + l,
-                                  (k + 1) * grid.azimuth + l + 1},
-                                 {(1 - fz) * (1 - fa), (1 - fz) * fa, fz * (1 - fa), fz * fa}};
-                        samples.push_back(s);
-                    }
-        std::vector<double> rows(size_t(dirs) * dirs, 0.0);
+        const int rows = (grid.zenith - 1) * kSub;  // zenith sub-rows
+        const double dpsi = kPi / (grid.azimuth - 1) / kSub;
+        // partial[i][row][l]: the row's solid angle times p(v_i . w) times the azimuth hat of node l.
+        std::vector<double> partial(size_t(dirs) * rows * grid.azimuth, 0.0);
+        auto row_zenith = [&](int row, double f) { return kPi * (row + f) / rows; };
         numerics::parallel_for(dirs, [&](int i) {
-            const double cz = std::cos(zenith_angle(i / grid.azimuth)), sz = std::sin(zenith_angle(i / grid.azimuth));
-            const double az = azimuth_angle(i % grid.azimuth);
-            double* row = &rows[size_t(i) * dirs];
-            for (const Sample& s : samples) {
-                // Both mirror images of the sample (azimuth +az and -az) carry the same field value.
-                const double value = s.solid * (hg(cz * s.cz + sz * s.sz * std::cos(az - s.az)) +
-                                                hg(cz * s.cz + sz * s.sz * std::cos(az + s.az)));
-                for (int q = 0; q < 4; ++q) row[s.corner[q]] += value * s.weight[q];
+            const double zi = zenith_angle(i / grid.azimuth), ai = azimuth_angle(i % grid.azimuth);
+            const double cz = std::cos(zi), sz = std::sin(zi);
+            for (int row = 0; row < rows; ++row) {
+                const double ze = row_zenith(row, 0.5), cs = std::cos(ze), ss = std::sin(ze);
+                const double solid = (std::cos(row_zenith(row, 0.0)) - std::cos(row_zenith(row, 1.0))) * dpsi;
+                double* out = &partial[(size_t(i) * rows + row) * grid.azimuth];
+                for (int l = 0; l + 1 < grid.azimuth; ++l)
+                    for (int c = 0; c < kSub; ++c) {
+                        const double fa = (c + 0.5) / kSub, az = azimuth_angle(l) + fa * kSub * dpsi;
+                        // Both mirror images of the sample (azimuth +az and -az) carry the same field value.
+                        const double value = solid * (hg(cz * cs + sz * ss * std::cos(ai - az)) +
+                                                      hg(cz * cs + sz * ss * std::cos(ai + az)));
+                        out[l] += value * (1.0 - fa);
+                        out[l + 1] += value * fa;
+                    }
+            }
+        });
+        GatherWeights w{std::vector<float>(size_t(dirs) * dirs), std::vector<float>(size_t(grid.radii) * dirs * dirs)};
+        numerics::parallel_for(dirs, [&](int i) {
+            std::vector<double> plain(dirs, 0.0), weighted(size_t(grid.radii) * dirs, 0.0);
+            for (int row = 0; row < rows; ++row) {
+                const int k = row / kSub;
+                const double fz = (row % kSub + 0.5) / kSub, ze = row_zenith(row, 0.5);
+                const double* in = &partial[(size_t(i) * rows + row) * grid.azimuth];
+                for (int l = 0; l < grid.azimuth; ++l) {
+                    plain[k * grid.azimuth + l] += in[l] * (1.0 - fz);
+                    plain[(k + 1) * grid.azimuth + l] += in[l] * fz;
+                }
+                for (int ir = 0; ir < grid.radii; ++ir) {
+                    const double u = meets(radial.radius(ir), ze);
+                    double* out = &weighted[size_t(ir) * dirs];
+                    for (int l = 0; l < grid.azimuth; ++l) {
+                        out[k * grid.azimuth + l] += u * in[l] * (1.0 - fz);
+                        out[(k + 1) * grid.azimuth + l] += u * in[l] * fz;
+                    }
+                }
             }
             double sum = 0.0;
-            for (int j = 0; j < dirs; ++j) sum += row[j];
-            for (int j = 0; j < dirs; ++j) row[j] /= sum;
+            for (double x : plain) sum += x;
+            for (int j = 0; j < dirs; ++j) w.plain[size_t(j) * dirs + i] = float(plain[j] / sum);
+            for (int ir = 0; ir < grid.radii; ++ir)
+                for (int j = 0; j < dirs; ++j)
+                    w.by_radius[(size_t(ir) * dirs + j) * dirs + i] = float(weighted[size_t(ir) * dirs + j] / sum);
         });
-        std::vector<float> transposed(size_t(dirs) * dirs);
-        for (int i = 0; i < dirs; ++i)
-            for (int j = 0; j < dirs; ++j) transposed[size_t(j) * dirs + i] = float(rows[size_t(i) * dirs + j]);
-        return transposed;
+        return w;
     }
 
     void solve() {
-        const std::vector<float> weights = gather_weights();
+        const GatherWeights weights = gather_weights();
+        std::vector<double> node_meets(size_t(grid.radii) * grid.zenith);  // U at each radius and zenith node
+        for (int ir = 0; ir < grid.radii; ++ir)
+            for (int k = 0; k < grid.zenith; ++k)
+                node_meets[size_t(ir) * grid.zenith + k] = meets(radial.radius(ir), zenith_angle(k));
         std::vector<float> radiance(size_t(positions) * dirs);  // I_k at the nodes
         std::vector<float> toward_sun(positions);               // I_k(y, sun) at the position nodes
         const Vec sun{0.0, 0.0, 1.0};
@@ -292,10 +315,20 @@ struct SphereScattering::Impl {
                 next.peak[p] = float(tau * c);
                 float* out = &next.rest[size_t(p) * dirs];
                 const float* in = &radiance[size_t(p) * dirs];
+                const int ir = p / grid.polar;
+                const float* weighted = &weights.by_radius[size_t(ir) * dirs * dirs];
+                const Vec y = node_position(p);
                 for (int j = 0; j < dirs; ++j) {
-                    const float a = float(tau * (in[j] - c * hg_of(peak_g, node_direction(p, j).z)));
-                    const float* column = &weights[size_t(j) * dirs];
-                    for (int i = 0; i < dirs; ++i) out[i] += a * column[i];
+                    // Eq. 2.10: I = U S with S smooth (the mean source along the ray; at U = 0 the source at y).
+                    const double u = node_meets[size_t(ir) * grid.zenith + j / grid.azimuth];
+                    const Vec w = node_direction(p, j);
+                    const double mean = u > 1e-7     ? in[j] / u
+                                        : order == 2 ? single_source(y, w) / tau
+                                                     : order_source(source.back(), y, w) / tau;
+                    const float a = float(tau * mean), b = float(-tau * c * hg_of(peak_g, w.z));
+                    const float* column = &weighted[size_t(j) * dirs];
+                    const float* plain = &weights.plain[size_t(j) * dirs];
+                    for (int i = 0; i < dirs; ++i) out[i] += a * column[i] + b * plain[i];
                 }
             });
             peak_g *= g;
