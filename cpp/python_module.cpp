@@ -23,6 +23,7 @@
 #include "airlight/scene_io.hpp"
 #include "airlight_tables.hpp"
 #include "noise.hpp"
+#include "particle_table.hpp"
 #include "phase_tables.hpp"
 #include "plane_parallel.hpp"
 #include "point_source.hpp"
@@ -279,6 +280,60 @@ airlight::SolverOptions solver_options(int streams, int max_fourier_mode, double
 
 }  // namespace
 
+// The particle clouds' solver grid (effects/particle_clouds/sphere_scattering.hpp) from a dict of
+// its fields; a ValueError names a bad key or value.
+airlight::SphereGrid parse_sphere_grid(const py::dict& keys) {
+    airlight::SphereGrid grid;
+    for (auto item : keys) {
+        const std::string key = py::str(item.first);
+        int* field = key == "radii"         ? &grid.radii
+                     : key == "polar"       ? &grid.polar
+                     : key == "zenith"      ? &grid.zenith
+                     : key == "azimuth"     ? &grid.azimuth
+                     : key == "march_steps" ? &grid.march_steps
+                     : key == "orders"      ? &grid.orders
+                                            : nullptr;
+        if (!field) throw py::value_error("grid." + key + ": unknown key");
+        *field = item.second.cast<int>();
+    }
+    try {
+        airlight::validate_sphere_grid(grid);
+    } catch (const std::invalid_argument& e) {
+        throw py::value_error(e.what());
+    }
+    return grid;
+}
+
+// The particle lighting table's shape (effects/particle_clouds/particle_table.hpp) from a dict.
+airlight::ParticleTableShape parse_particle_table_shape(const py::dict& keys) {
+    airlight::ParticleTableShape shape;
+    for (auto item : keys) {
+        const std::string key = py::str(item.first);
+        if (key == "grid") {
+            shape.grid = parse_sphere_grid(item.second.cast<py::dict>());
+            continue;
+        }
+        if (key == "tau_min" || key == "tau_max") {
+            (key == "tau_min" ? shape.tau_min : shape.tau_max) = item.second.cast<double>();
+            continue;
+        }
+        int* field = key == "entry"          ? &shape.entry
+                     : key == "view_zenith"  ? &shape.view_zenith
+                     : key == "view_azimuth" ? &shape.view_azimuth
+                     : key == "taus"         ? &shape.taus
+                     : key == "steps"        ? &shape.steps
+                                             : nullptr;
+        if (!field) throw py::value_error("shape." + key + ": unknown key");
+        *field = item.second.cast<int>();
+    }
+    try {
+        airlight::validate_particle_table_shape(shape);
+    } catch (const std::invalid_argument& e) {
+        throw py::value_error(e.what());
+    }
+    return shape;
+}
+
 PYBIND11_MODULE(_core, m) {
     m.doc() = "airlight native core (use the airlight package, not this module)";
 
@@ -479,24 +534,7 @@ PYBIND11_MODULE(_core, m) {
         [](double tau, double g, std::array<double, 3> sun,
            py::array_t<double, py::array::c_style | py::array::forcecast> origins,
            py::array_t<double, py::array::c_style | py::array::forcecast> dirs, py::dict grid_keys, int steps) {
-            airlight::SphereGrid grid;
-            for (auto item : grid_keys) {
-                const std::string key = py::str(item.first);
-                int* field = key == "radii"         ? &grid.radii
-                             : key == "polar"       ? &grid.polar
-                             : key == "zenith"      ? &grid.zenith
-                             : key == "azimuth"     ? &grid.azimuth
-                             : key == "march_steps" ? &grid.march_steps
-                             : key == "orders"      ? &grid.orders
-                                                    : nullptr;
-                if (!field) throw py::value_error("grid." + key + ": unknown key");
-                *field = item.second.cast<int>();
-            }
-            try {
-                airlight::validate_sphere_grid(grid);
-            } catch (const std::invalid_argument& e) {
-                throw py::value_error(e.what());
-            }
+            const airlight::SphereGrid grid = parse_sphere_grid(grid_keys);
             if (steps < 1 || steps > 1 << 16) throw py::value_error("steps: must be in [1, 65536]");
             if (origins.ndim() != 2 || origins.shape(1) != 3 || dirs.ndim() != 2 || dirs.shape(1) != 3 ||
                 dirs.shape(0) != origins.shape(0))
@@ -548,6 +586,44 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("tau"), py::arg("g"), py::arg("sun"), py::arg("origins"), py::arg("dirs"), py::arg("grid") = py::dict(),
         py::arg("steps") = 256);
+    // The particle clouds' lighting table (effects/particle_clouds/particle_table.hpp), for tests and
+    // the resolution analysis: built for g and a shape dict; lookup(tau, normals, views, sun) gives an
+    // (n, 2) array (order 1, orders 2..N) for rays entering where the unit outward normal is `normals`.
+    py::class_<airlight::ParticleTable>(m, "ParticleTable")
+        .def(py::init([](double g, py::dict shape) {
+                 const airlight::ParticleTableShape parsed = parse_particle_table_shape(shape);
+                 py::gil_scoped_release release;
+                 try {
+                     return std::make_unique<airlight::ParticleTable>(g, parsed);
+                 } catch (const std::invalid_argument& e) {
+                     py::gil_scoped_acquire acquire;
+                     throw py::value_error(e.what());
+                 }
+             }),
+             py::arg("g"), py::arg("shape") = py::dict())
+        .def_property_readonly("build_seconds", &airlight::ParticleTable::build_seconds)
+        .def_property_readonly("bytes",
+                               [](const airlight::ParticleTable& t) { return t.nodes().size() * sizeof(float); })
+        .def(
+            "lookup",
+            [](const airlight::ParticleTable& t, py::array_t<double, py::array::c_style | py::array::forcecast> taus,
+               py::array_t<double, py::array::c_style | py::array::forcecast> normals,
+               py::array_t<double, py::array::c_style | py::array::forcecast> views, std::array<double, 3> sun) {
+                const py::ssize_t n = normals.ndim() == 2 ? normals.shape(0) : -1;
+                if (n < 0 || normals.shape(1) != 3 || views.ndim() != 2 || views.shape(0) != n || views.shape(1) != 3 ||
+                    taus.ndim() != 1 || taus.shape(0) != n)
+                    throw py::value_error("taus, normals, views: must be (n,), (n, 3), (n, 3) arrays");
+                py::array_t<double> out({n, py::ssize_t(2)});
+                double* r = out.mutable_data();
+                for (py::ssize_t i = 0; i < n; ++i) {
+                    const std::array<double, 2> v =
+                        t.lookup(taus.data()[i], normals.data() + 3 * i, views.data() + 3 * i, sun.data());
+                    r[2 * i] = v[0];
+                    r[2 * i + 1] = v[1];
+                }
+                return out;
+            },
+            py::arg("taus"), py::arg("normals"), py::arg("views"), py::arg("sun"));
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

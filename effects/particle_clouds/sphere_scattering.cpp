@@ -5,6 +5,7 @@
 #include <algorithm>
 #include <array>
 #include <cmath>
+#include <cstdint>
 #include <stdexcept>
 #include <string>
 
@@ -97,6 +98,9 @@ struct SphereScattering::Impl {
         double peak_g;            // g^k
     };
     std::vector<OrderSource> source;  // source[k - 2]
+    // The orders >= 2 summed, for single_and_multiple: sum_k R_k on the grid and e_k by position.
+    std::vector<float> rest_sum;
+    std::vector<float> peaks;  // [position][k - 2]
 
     Impl(double tau_, double g_, const SphereGrid& grid_) : tau(tau_), g(g_), grid(grid_), radial(grid_.radii, tau_) {
         dirs = grid.zenith * grid.azimuth;
@@ -152,14 +156,16 @@ struct SphereScattering::Impl {
         }
         return sum;
     }
-    // J_k at x toward an observer looking along w, from its grid (eq. 2.8).
-    double order_source(const OrderSource& o, const Vec& x, const Vec& w) const {
-        const GridPoint p = locate(x, w);
+    // J_k at grid point p toward an observer looking along w, from its grid (eq. 2.8).
+    double order_source(const OrderSource& o, const GridPoint& p, const Vec& w) const {
         const int base = p.node[0] * grid.polar + p.node[1];
         const double f0 = p.frac[0], f1 = p.frac[1];
         const double peak = (1 - f0) * ((1 - f1) * o.peak[base] + f1 * o.peak[base + 1]) +
                             f0 * ((1 - f1) * o.peak[base + grid.polar] + f1 * o.peak[base + grid.polar + 1]);
         return peak * hg_of(o.peak_g, w.z) + interpolate(o.rest, p);
+    }
+    double order_source(const OrderSource& o, const Vec& x, const Vec& w) const {
+        return order_source(o, locate(x, w), w);
     }
     Vec node_position(int position) const {
         const double r = radial.radius(position / grid.polar), th = polar_angle(position % grid.polar);
@@ -180,31 +186,39 @@ struct SphereScattering::Impl {
     // through) and at `steps` points uniform in t (the far part of the chord, where a back-lit source
     // grows); between samples F = f e^{-tau t} is taken as exponential, whose integral over a step h is
     // h times the logarithmic mean of F at its ends (eq. 2.6). source(x) gives f at x, once per sample.
-    template <class Source>
-    double march(const Vec& y, const Vec& w, int steps, const Source& source) const {
+    // The sample distances of eq. 2.6 along the ray from y along w, in increasing order, through
+    // visit(t): t = 0, `steps` points uniform in u and `steps` points uniform in t (the last at the
+    // exit distance d); none when d = 0.
+    template <class Visit>
+    void march_points(const Vec& y, const Vec& w, int steps, const Visit& visit) const {
         const double d = exit_distance(y, w);
-        if (!(d > 0.0)) return 0.0;
+        if (!(d > 0.0)) return;
         const double total = -std::expm1(-tau * d);  // U
-        double sum = 0.0, t_prev = 0.0, f_prev = source(y);
+        visit(0.0);
         int iu = 0, it = 1;  // next u-sample (midpoints) and t-sample (it / steps of d; the last is the end)
         while (iu < steps || it <= steps) {
             const double tu = iu < steps ? -std::log1p(-total * (iu + 0.5) / steps) / tau : 2.0 * d;
             const double tt = d * it / steps;
-            double t;
             if (tu < tt) {
-                t = tu;
+                visit(std::min(tu, d));
                 ++iu;
             } else {
-                t = tt;
+                visit(tt);
                 ++it;
             }
-            t = std::min(t, d);
-            const double f = source(y + t * w);
-            const double a = f_prev * std::exp(-tau * t_prev), b = f * std::exp(-tau * t), h = t - t_prev;
-            sum += h * log_mean(a, b);
+        }
+    }
+    template <class Source>
+    double march(const Vec& y, const Vec& w, int steps, const Source& source) const {
+        double sum = 0.0, t_prev = 0.0, f_prev = 0.0;
+        bool first = true;
+        march_points(y, w, steps, [&](double t) {
+            const double f = source(y + t * w) * std::exp(-tau * t);
+            if (!first) sum += (t - t_prev) * log_mean(f_prev, f);
+            first = false;
             t_prev = t;
             f_prev = f;
-        }
+        });
         return sum;
     }
     // The logarithmic mean (b - a) / ln(b / a): the mean of an exponential between the values a and b
@@ -285,6 +299,60 @@ struct SphereScattering::Impl {
         return w;
     }
 
+    // A sample of a node ray located on the grid once, for every order's march (eq. 2.6): the grid
+    // cell (its lower corner's flat index and the fractions toward the next node, 1/65535 steps) and
+    // the distance t along the ray.
+    struct PlannedSample {
+        int32_t base;
+        uint16_t frac[4];
+        float t;
+    };
+    int samples_per_ray() const { return 2 * grid.march_steps + 1; }
+    // Fills the samples of the ray from y along w (all with t = 0 when the ray leaves at once).
+    void plan_ray(const Vec& y, const Vec& w, PlannedSample* out) const {
+        int n = 0;
+        const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
+        march_points(y, w, grid.march_steps, [&](double t) {
+            const GridPoint p = locate(y + t * w, w);
+            PlannedSample& s = out[n++];
+            s.base = p.node[0] * stride[0] + p.node[1] * stride[1] + p.node[2] * stride[2] + p.node[3];
+            for (int axis = 0; axis < 4; ++axis) s.frac[axis] = uint16_t(std::lround(p.frac[axis] * 65535.0));
+            s.t = float(t);
+        });
+        for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{0, {0, 0, 0, 0}, 0.0f};
+    }
+    // Eq. 2.6 over planned samples of the ray whose direction has sun . w = cos_sun.
+    double planned_march(const PlannedSample* samples, const OrderSource& o, double cos_sun) const {
+        const double peak_phase = hg_of(o.peak_g, cos_sun);
+        const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
+        double sum = 0.0, f_prev = 0.0, t_prev = 0.0;
+        for (int i = 0; i < samples_per_ray(); ++i) {
+            const PlannedSample& s = samples[i];
+            double frac[4];
+            for (int axis = 0; axis < 4; ++axis) frac[axis] = s.frac[axis] / 65535.0;
+            double rest = 0.0;
+            for (int corner = 0; corner < 16; ++corner) {
+                double weight = 1.0;
+                int index = s.base;
+                for (int axis = 0; axis < 4; ++axis) {
+                    const bool upper = (corner >> axis) & 1;
+                    weight *= upper ? frac[axis] : 1.0 - frac[axis];
+                    index += upper ? stride[axis] : 0;
+                }
+                rest += weight * o.rest[index];
+            }
+            const int position = s.base / dirs;
+            const double peak =
+                (1 - frac[0]) * ((1 - frac[1]) * o.peak[position] + frac[1] * o.peak[position + 1]) +
+                frac[0] * ((1 - frac[1]) * o.peak[position + grid.polar] + frac[1] * o.peak[position + grid.polar + 1]);
+            const double f = (peak * peak_phase + rest) * std::exp(-tau * double(s.t));
+            if (i > 0) sum += (double(s.t) - t_prev) * log_mean(f_prev, f);
+            f_prev = f;
+            t_prev = s.t;
+        }
+        return sum;
+    }
+
     void solve() {
         const GatherWeights weights = gather_weights();
         std::vector<double> node_meets(size_t(grid.radii) * grid.zenith);  // U at each radius and zenith node
@@ -294,6 +362,16 @@ struct SphereScattering::Impl {
         std::vector<float> radiance(size_t(positions) * dirs);  // I_k at the nodes
         std::vector<float> toward_sun(positions);               // I_k(y, sun) at the position nodes
         const Vec sun{0.0, 0.0, 1.0};
+        // Every node ray's samples, located once (rays [position][direction], then one toward the sun
+        // per position): the march of orders >= 2 reads them.
+        const size_t per_ray = size_t(samples_per_ray()), rays = size_t(positions) * (dirs + 1);
+        std::vector<PlannedSample> plan(rays * per_ray);
+        numerics::parallel_for(positions, [&](int p) {
+            const Vec y = node_position(p);
+            for (int d = 0; d < dirs; ++d)
+                plan_ray(y, node_direction(p, d), &plan[(size_t(p) * (dirs + 1) + d) * per_ray]);
+            plan_ray(y, sun, &plan[(size_t(p) * (dirs + 1) + dirs) * per_ray]);
+        });
         // Order 1's radiance at the nodes, from its analytic source.
         numerics::parallel_for(positions, [&](int p) {
             const Vec y = node_position(p);
@@ -337,15 +415,18 @@ struct SphereScattering::Impl {
             // Eq. 2.4: this order's radiance at the nodes, marching its source.
             const OrderSource& field = source.back();
             numerics::parallel_for(positions, [&](int p) {
-                const Vec y = node_position(p);
-                for (int d = 0; d < dirs; ++d) {
-                    const Vec w = node_direction(p, d);
+                const PlannedSample* ray = &plan[size_t(p) * (dirs + 1) * per_ray];
+                for (int d = 0; d < dirs; ++d)
                     radiance[size_t(p) * dirs + d] =
-                        float(march(y, w, grid.march_steps, [&](const Vec& x) { return order_source(field, x, w); }));
-                }
-                toward_sun[p] =
-                    float(march(y, sun, grid.march_steps, [&](const Vec& x) { return order_source(field, x, sun); }));
+                        float(planned_march(ray + d * per_ray, field, node_direction(p, d).z));
+                toward_sun[p] = float(planned_march(ray + dirs * per_ray, field, 1.0));
             });
+        }
+        rest_sum.assign(size_t(positions) * dirs, 0.0f);
+        peaks.assign(size_t(positions) * source.size(), 0.0f);
+        for (size_t k = 0; k < source.size(); ++k) {
+            for (size_t i = 0; i < rest_sum.size(); ++i) rest_sum[i] += source[k].rest[i];
+            for (int p = 0; p < positions; ++p) peaks[size_t(p) * source.size() + k] = source[k].peak[p];
         }
     }
 };
@@ -364,13 +445,63 @@ double SphereScattering::tau() const { return impl_->tau; }
 double SphereScattering::g() const { return impl_->g; }
 const SphereGrid& SphereScattering::grid() const { return impl_->grid; }
 
+// The ray's entry point into the unit sphere (origin outside or on it), false when it misses.
+static bool sphere_entry(const Vec& o, const Vec& v, Vec& entry) {
+    const double b = dot(o, v), c = dot(o, o) - 1.0, disc = b * b - c;
+    if (!(disc > 0.0) || (c > 0.0 && b >= 0.0)) return false;        // misses, or starts outside moving away
+    const double t_in = c > 0.0 ? c / (-b + std::sqrt(disc)) : 0.0;  // near root, without cancellation
+    entry = o + t_in * v;
+    return true;
+}
+
+std::array<double, 4> SphereScattering::table_channels(const double origin[3], const double dir[3], int steps) const {
+    const Vec o{origin[0], origin[1], origin[2]}, v{dir[0], dir[1], dir[2]};
+    Vec entry;
+    if (!sphere_entry(o, v, entry)) return {0.0, 0.0, 0.0, 0.0};
+    std::array<double, 4> out{0.0, 0.0, 0.0, 0.0};
+    // Order 1 over its phase (eq. 2.2: p(sun . v) is the same all along the ray).
+    out[0] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->single_source(x, v); }) / impl_->hg(v.z);
+    const size_t orders = impl_->source.size();
+    const int polar = impl_->grid.polar;
+    // e_k at x, bilinear in the position (eq. 2.8), for orders k = 2 and 3 by themselves.
+    auto peak_integral = [&](size_t k) {
+        return impl_->march(entry, v, steps, [&](const Vec& x) {
+            const GridPoint p = impl_->locate(x, v);
+            const std::vector<float>& e = impl_->source[k].peak;
+            const int base = p.node[0] * polar + p.node[1];
+            const double f0 = p.frac[0], f1 = p.frac[1];
+            return (1 - f0) * ((1 - f1) * e[base] + f1 * e[base + 1]) +
+                   f0 * ((1 - f1) * e[base + polar] + f1 * e[base + polar + 1]);
+        });
+    };
+    if (orders >= 1) out[1] = peak_integral(0);
+    if (orders >= 2) out[2] = peak_integral(1);
+    if (orders == 0) return out;
+    // The rest of orders >= 2 at once: the rests' sum and the peaks of orders >= 4.
+    std::vector<double> peak_phase(orders, 0.0);
+    for (size_t k = 2; k < orders; ++k) peak_phase[k] = Impl::hg_of(impl_->source[k].peak_g, v.z);
+    out[3] = impl_->march(entry, v, steps, [&](const Vec& x) {
+        const GridPoint p = impl_->locate(x, v);
+        auto peak_at = [&](int position) {
+            const float* e = &impl_->peaks[size_t(position) * orders];
+            double sum = 0.0;
+            for (size_t k = 2; k < orders; ++k) sum += e[k] * peak_phase[k];
+            return sum;
+        };
+        const int base = p.node[0] * polar + p.node[1];
+        const double f0 = p.frac[0], f1 = p.frac[1];
+        const double peak = (1 - f0) * ((1 - f1) * peak_at(base) + f1 * peak_at(base + 1)) +
+                            f0 * ((1 - f1) * peak_at(base + polar) + f1 * peak_at(base + polar + 1));
+        return peak + impl_->interpolate(impl_->rest_sum, p);
+    });
+    return out;
+}
+
 std::vector<double> SphereScattering::radiance_orders(const double origin[3], const double dir[3], int steps) const {
     std::vector<double> out(size_t(impl_->grid.orders), 0.0);
     const Vec o{origin[0], origin[1], origin[2]}, v{dir[0], dir[1], dir[2]};
-    const double b = dot(o, v), c = dot(o, o) - 1.0, disc = b * b - c;
-    if (!(disc > 0.0) || (c > 0.0 && b >= 0.0)) return out;          // misses, or starts outside moving away
-    const double t_in = c > 0.0 ? c / (-b + std::sqrt(disc)) : 0.0;  // near root, without cancellation
-    const Vec entry = o + t_in * v;
+    Vec entry;
+    if (!sphere_entry(o, v, entry)) return out;
     out[0] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->single_source(x, v); });
     for (size_t k = 0; k < impl_->source.size(); ++k) {
         const Impl::OrderSource& field = impl_->source[k];

@@ -5,6 +5,7 @@
 // the sun on +z: sunlight travels along -z with irradiance 1.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <vector>
 
@@ -17,7 +18,7 @@ struct SphereGrid {
     int polar = 32;        // the position's angle from the sun's axis, [0, pi]
     int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
     int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
-    int march_steps = 32;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
+    int march_steps = 16;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
     int orders = 18;       // scattering orders solved (the source sums 18)
 };
 
@@ -39,6 +40,11 @@ public:
     // (unit) from `origin` receives from the sphere (0 for a ray that misses
     // it), the ray integral taken with `steps` steps (eq. 2.4).
     std::vector<double> radiance_orders(const double origin[3], const double dir[3], int steps) const;
+    // What the particle table stores for the same ray (physics.md eq. 3.1): order 1 over its phase
+    // p_g(sun . v); the ray integrals of orders 2 and 3's peak coefficients (eq. 2.8), whose phases
+    // p_{g^2}, p_{g^3} are the same all along the ray; and the rest of orders 2..orders (their R_k and
+    // the peaks of orders >= 4) in one march. Radiance = c0 p_g + c1 p_{g^2} + c2 p_{g^3} + c3.
+    std::array<double, 4> table_channels(const double origin[3], const double dir[3], int steps) const;
 
     double tau() const;
     double g() const;
