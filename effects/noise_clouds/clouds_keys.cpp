@@ -2,6 +2,7 @@
 // "cloud_steps", "cloud_light_steps", "cloud_shadow_steps" (README "Scene format"; physics.md),
 // parsed and written back through the registry (EFFECT_SCENE_KEYS,
 // EFFECT_QUALITY_KEYS; cpp/scene_keys.hpp).
+#include <algorithm>
 #include <stdexcept>
 #include <string>
 
@@ -35,6 +36,9 @@ WeatherMap parse_weather_map(const SceneObject& o) {
     if (auto v = o.opt("center")) read_pair(*v, -1e7, 1e7, m.center_x, m.center_z);
     try {
         m.texels = load_weather_map(m.image);
+        m.max_coverage = 0.0f;
+        for (size_t i = 0; i < m.texels->texels.size(); i += size_t(m.texels->channels))
+            m.max_coverage = std::max(m.max_coverage, m.texels->texels[i]);
     } catch (const std::runtime_error& e) {
         fail(Kind::value, image.field, e.what());
     }

@@ -19,6 +19,7 @@ struct WeatherMap {
     float size_x = 0.0f, size_z = 0.0f;
     float center_x = 0.0f, center_z = 0.0f;
     std::shared_ptr<const Table2D> texels;  // null: no weather map
+    float max_coverage = 1.0f;              // the largest red texel: 0 means the map clears the sky
 };
 
 // A layer of cloud between two altitudes whose density comes from two tiling
@@ -45,9 +46,13 @@ struct Clouds {
     WeatherMap weather_map;       // optional: coverage and type varying over the ground
 };
 
-// Clouds that can be seen or cast shadows: some coverage and extinction (a
-// scene without builds no texture and runs no cloud code).
-inline bool clouds_visible(const Clouds& c) { return c.present && c.coverage > 0.0f && c.extinction > 0.0f; }
+// Clouds that can be seen or cast shadows: some coverage (after the weather
+// map's) and extinction (a scene without builds no texture and runs no cloud
+// code).
+inline bool clouds_visible(const Clouds& c) {
+    const float map = c.weather_map.texels ? c.weather_map.max_coverage : 1.0f;
+    return c.present && c.coverage * map > 0.0f && c.extinction > 0.0f;
+}
 
 enum class CloudsMethod {
     adaptive,  // steps growing with distance, empty space crossed in long steps, early stop (physics.md section 4)

@@ -325,6 +325,15 @@ def with_map(path: str, **clouds: Any) -> dict[str, Any]:
     return with_clouds(**clouds, weather_map={"image": path, "size": [6000, 5000], "center": [100, -2000]})
 
 
+def test_weather_map_that_clears_the_sky_builds_no_noise(tmp_path):
+    # An all-zero red channel leaves no coverage anywhere: no noise texture, no cloud code (the map
+    # itself is read to know it).
+    path = write_png(tmp_path / "clear.png", np.zeros((4, 6)))
+    built = tables_built_by({**SKY_SCENE, "clouds": {**SKY_SCENE["clouds"], "weather_map": {
+        "image": path, "size": [6000, 5000]}}})
+    assert not {"cloud_shape", "cloud_detail"} & set(built), built
+
+
 def test_weather_map_is_read_with_its_keys_and_written_back(tmp_path):
     path = write_png(tmp_path / "map.png", np.full((4, 6, 3), 0.5))
     scene = airlight.load_scene(with_map(path))
