@@ -127,20 +127,30 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
         return std::array<double, 2>{v[0] * p1, v[1] * p2 + v[2] * p3 + v[3]};
     };
     // Eq. 3.3: across the slices a Catmull-Rom cubic in log tau through the four around it (a missing
-    // end continued linearly), clamped at zero. The light of a ray is not monotonic in tau (single
-    // scattering falls where multiple rises), which linear interpolation between slices 1.76 apart
-    // misses by 5-10 %.
+    // end continued linearly), of the logarithm of the light where all four are positive (a ray into
+    // a thick particle's shadow dims exponentially with tau), of the light itself clamped at zero
+    // otherwise. The light of a ray is not monotonic in tau (single scattering falls where multiple
+    // rises), which linear interpolation between slices a factor 2 apart misses by 5-8 %.
     const int m = node[3];
     const std::array<double, 2> v0 = slice_light(m), v1 = slice_light(m + 1);
-    const std::array<double, 2> vm =
-        m > 0 ? slice_light(m - 1) : std::array<double, 2>{2 * v0[0] - v1[0], 2 * v0[1] - v1[1]};
-    const std::array<double, 2> v2 =
-        m + 2 < shape_.taus ? slice_light(m + 2) : std::array<double, 2>{2 * v1[0] - v0[0], 2 * v1[1] - v0[1]};
+    const bool below = m > 0, above = m + 2 < shape_.taus;
+    const std::array<double, 2> vm = below ? slice_light(m - 1) : std::array<double, 2>{0.0, 0.0};
+    const std::array<double, 2> v2 = above ? slice_light(m + 2) : std::array<double, 2>{0.0, 0.0};
     const double f = frac[3], f2 = f * f, f3 = f2 * f;
     const double w[4] = {0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2), 0.5 * (-3 * f3 + 4 * f2 + f),
                          0.5 * (f3 - f2)};
+    auto cubic = [&](double a, double b, double c, double d, bool has_a, bool has_d) {
+        if (!has_a) a = 2 * b - c;
+        if (!has_d) d = 2 * c - b;
+        return w[0] * a + w[1] * b + w[2] * c + w[3] * d;
+    };
     std::array<double, 2> out;
-    for (int k = 0; k < 2; ++k) out[k] = std::max(0.0, w[0] * vm[k] + w[1] * v0[k] + w[2] * v1[k] + w[3] * v2[k]);
+    for (int k = 0; k < 2; ++k) {
+        const bool positive = v0[k] > 0.0 && v1[k] > 0.0 && (!below || vm[k] > 0.0) && (!above || v2[k] > 0.0);
+        out[k] = positive ? std::exp(cubic(below ? std::log(vm[k]) : 0.0, std::log(v0[k]), std::log(v1[k]),
+                                           above ? std::log(v2[k]) : 0.0, below, above))
+                          : std::max(0.0, cubic(vm[k], v0[k], v1[k], v2[k], below, above));
+    }
     return {out[0] * thin, out[1] * thin * thin};
 }
 

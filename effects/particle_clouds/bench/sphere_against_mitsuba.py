@@ -42,14 +42,15 @@ side, down to 1e-40, which Mitsuba barely samples): the median and the largest r
 (rays where |difference| > max(2 % of Mitsuba, 3 Mitsuba standard errors): the acceptance). Every
 failing ray is listed after the table.
 
-Reading the default run (docs/sphere_against_mitsuba.txt; a few failing rays re-checked by hand
-against sphere_paths' closed-form single scattering and its float64 path tracer): order 1's failures
-at tau 20 and 50 are Mitsuba's (the solver equals the closed form to 4 digits; Mitsuba is 2-12 % low
-on rays entering where the sun grazes, even at radius 100); the solver's large excesses in orders
-2, 3 and the sum at tau 20 and 50 (rays entering in the shadow or at the terminator, 10-280 %) and
-at tau 5 (sum, +3-6 %) are the solver's (sphere_paths agrees with Mitsuba); at tau 0.1, g 0.9 the
-failing orders 2 and 3 (radiances near the 1e-3 floor, front- and side-lit) agree with sphere_paths,
-Mitsuba being low there with heavy tails its batch-means error misses.
+Reading the default run (effects/particle_clouds/docs/sphere_against_mitsuba.txt; a few failing rays
+re-checked by hand against sphere_paths' closed-form single scattering and its float64 path tracer):
+order 1's failures at tau 20 and 50 are Mitsuba's (the solver equals the closed form to 4 digits;
+Mitsuba is 2-12 % low on rays entering where the sun grazes, even at radius 100); the solver's large
+excesses in orders 2, 3 and the sum at tau 20 and 50 (rays entering in the shadow or at the
+terminator, 10-280 %) and at tau 5 (sum, +3-6 %) are the solver's (sphere_paths agrees with
+Mitsuba); at tau 0.1, g 0.9 the failing orders 2 and 3 (radiances near the 1e-3 floor, front- and
+side-lit) agree with sphere_paths, Mitsuba being low there with heavy tails its batch-means error
+misses.
 
 Runtime of the default sweep (15 cases, 25 rays, 2^20 samples per ray and max_depth): 9.3 minutes
 on 2 cores shared with another job (load average 4-5; solver 119 s, about 8 s per case for 18
