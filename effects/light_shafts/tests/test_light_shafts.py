@@ -166,13 +166,23 @@ def test_random_occluders_match_the_reference(renderer_cache, data):
     draw = data.draw
     coordinate = st.floats(-30, 30)
     surfaces: list[dict[str, Any]] = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0]}]
+    # The camera (STREET's, at (0, 1.7, 0)) stays outside every caster, 1 cm clear of it: a camera on
+    # a box's face or edge is a degenerate scene (inside or outside is a matter of rounding, and the
+    # renderer and the reference may round differently), not a shadow to measure.
+    camera = np.array(STREET["camera"]["position"], float)
     for _ in range(draw(st.integers(1, 8))):
         lo = [draw(coordinate), draw(st.floats(0, 5)), draw(st.floats(-80, -5))]
         size = [draw(st.floats(0.05, 12)) for _ in range(3)]
-        surfaces.append({"type": "box", "min": lo, "max": [a + b for a, b in zip(lo, size)]})
+        hi = [a + b for a, b in zip(lo, size)]
+        if all(a - 0.01 <= c <= b + 0.01 for a, b, c in zip(lo, hi, camera)):
+            continue
+        surfaces.append({"type": "box", "min": lo, "max": hi})
     for _ in range(draw(st.integers(0, 3))):
         centre = [draw(coordinate), draw(st.floats(0, 15)), draw(st.floats(-80, -5))]
-        surfaces.append({"type": "sphere", "center": centre, "radius": draw(st.floats(0.1, 6))})
+        radius = draw(st.floats(0.1, 6))
+        if np.linalg.norm(np.subtract(centre, camera)) <= radius + 0.01:
+            continue
+        surfaces.append({"type": "sphere", "center": centre, "radius": radius})
     axis = st.sampled_from([0.0, 0.0, 1.0, -1.0]) | st.floats(-1, 1)
     sun = [draw(axis), draw(st.sampled_from([1.0]) | st.floats(0.02, 1)), draw(axis)]
     scene = copy.deepcopy(STREET)
