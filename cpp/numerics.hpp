@@ -5,6 +5,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <cmath>
 #include <thread>
 #include <vector>
 
@@ -20,6 +21,21 @@ constexpr double kGaussLegendre8Nodes[8] = {-0.9602898564975363, -0.796666477413
 constexpr double kGaussLegendre8Weights[8] = {0.1012285362903763, 0.2223810344533745, 0.3137066458778873,
                                               0.3626837833783620, 0.3626837833783620, 0.3137066458778873,
                                               0.2223810344533745, 0.1012285362903763};
+
+// The Henyey-Greenstein phase function (normalised over the sphere) at the cosine mu between the
+// light's directions of travel before and after scattering.
+inline double henyey_greenstein(double g, double mu) {
+    const double den = 1.0 + g * g - 2.0 * g * mu;
+    return (1.0 - g * g) / (4.0 * kPi * den * std::sqrt(den));
+}
+
+// A fractional node index x on a grid of n >= 2 nodes: the lower node (clamped to [0, n - 2]) and the
+// fraction toward the next, for linear interpolation.
+inline void node_and_fraction(double x, int n, int& node, double& frac) {
+    x = std::clamp(x, 0.0, double(n - 1));
+    node = std::min(int(x), n - 2);
+    frac = x - node;
+}
 
 // The number of threads a pool uses: `requested` when > 0, else the machine's cores.
 inline int thread_count(int requested = 0) {

@@ -14,16 +14,8 @@ namespace {
 
 using numerics::kPi;
 
-double hg(double g, double c) {
-    const double den = 1.0 + g * g - 2.0 * g * c;
-    return (1.0 - g * g) / (4.0 * kPi * den * std::sqrt(den));
-}
-
-void split(double x, int n, int& node, double& frac) {
-    x = std::clamp(x, 0.0, double(n - 1));
-    node = std::min(int(x), n - 2);
-    frac = x - node;
-}
+using numerics::node_and_fraction;
+double hg(double g, double mu) { return numerics::henyey_greenstein(g, mu); }
 
 }  // namespace
 
@@ -98,13 +90,14 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
     const int E = shape_.entry, Z = shape_.view_zenith, A = shape_.view_azimuth;
     int node[4];
     double frac[4];
-    split(std::acos(cos_entry) / kPi * (E - 1), E, node[0], frac[0]);
-    split((1.0 - std::pow(1.0 - std::acos(cos_view) / (0.5 * kPi), 1.0 / 1.5)) * (Z - 1), Z, node[1], frac[1]);
-    split(psi / kPi * (A - 1), A, node[2], frac[2]);
+    node_and_fraction(std::acos(cos_entry) / kPi * (E - 1), E, node[0], frac[0]);
+    node_and_fraction((1.0 - std::pow(1.0 - std::acos(cos_view) / (0.5 * kPi), 1.0 / 1.5)) * (Z - 1), Z, node[1],
+                      frac[1]);
+    node_and_fraction(psi / kPi * (A - 1), A, node[2], frac[2]);
     // Eq. 3.2: the optical radius, log-uniform; below tau_min order 1 scales with tau and the rest with
     // tau^2 (thin particles), above tau_max the thickest slice stands.
     const double x = std::log(std::max(tau, 1e-30) / shape_.tau_min) / std::log(shape_.tau_max / shape_.tau_min);
-    split(x * (shape_.taus - 1), shape_.taus, node[3], frac[3]);
+    node_and_fraction(x * (shape_.taus - 1), shape_.taus, node[3], frac[3]);
     const double thin = std::min(1.0, tau / shape_.tau_min);
     const size_t stride[3] = {size_t(Z) * A * 4, size_t(A) * 4, 4};
     // Eq. 3.1: a slice's order 1 and orders 2..N, trilinear in the angles, with the phases of order 1

@@ -64,11 +64,7 @@ struct GridPoint {
     std::array<double, 4> frac;
 };
 
-void split(double x, int n, int& node, double& frac) {
-    x = std::clamp(x, 0.0, double(n - 1));
-    node = std::min(int(x), n - 2);
-    frac = x - node;
-}
+using numerics::node_and_fraction;
 
 }  // namespace
 
@@ -107,10 +103,7 @@ struct SphereScattering::Impl {
         positions = grid.radii * grid.polar;
     }
 
-    static double hg_of(double gk, double c) {
-        const double den = 1.0 + gk * gk - 2.0 * gk * c;
-        return (1.0 - gk * gk) / (4.0 * kPi * den * std::sqrt(den));
-    }
+    static double hg_of(double gk, double c) { return numerics::henyey_greenstein(gk, c); }
     double hg(double c) const { return hg_of(g, c); }
     // Order 1's source (eq. 2.2): the sun's light attenuated to y, scattered toward -w.
     double single_source(const Vec& y, const Vec& w) const {
@@ -132,11 +125,13 @@ struct SphereScattering::Impl {
         Vec n, t, b;
         frame(y, n, t, b);
         GridPoint p;
-        split(radial.index(std::sqrt(dot(y, y))), grid.radii, p.node[0], p.frac[0]);
-        split(std::atan2(std::hypot(n.x, n.y), n.z) / kPi * (grid.polar - 1), grid.polar, p.node[1], p.frac[1]);
-        split(std::acos(std::clamp(dot(w, n), -1.0, 1.0)) / kPi * (grid.zenith - 1), grid.zenith, p.node[2], p.frac[2]);
-        split(std::atan2(std::fabs(dot(w, b)), dot(w, t)) / kPi * (grid.azimuth - 1), grid.azimuth, p.node[3],
-              p.frac[3]);
+        node_and_fraction(radial.index(std::sqrt(dot(y, y))), grid.radii, p.node[0], p.frac[0]);
+        node_and_fraction(std::atan2(std::hypot(n.x, n.y), n.z) / kPi * (grid.polar - 1), grid.polar, p.node[1],
+                          p.frac[1]);
+        node_and_fraction(std::acos(std::clamp(dot(w, n), -1.0, 1.0)) / kPi * (grid.zenith - 1), grid.zenith, p.node[2],
+                          p.frac[2]);
+        node_and_fraction(std::atan2(std::fabs(dot(w, b)), dot(w, t)) / kPi * (grid.azimuth - 1), grid.azimuth,
+                          p.node[3], p.frac[3]);
         return p;
     }
     // Quadrilinear interpolation of a field on the grid.
