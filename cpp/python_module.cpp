@@ -22,7 +22,9 @@
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
 #include "airlight_tables.hpp"
+#include "frame_data.hpp"
 #include "noise.hpp"
+#include "particle_field.hpp"
 #include "particle_table.hpp"
 #include "phase_tables.hpp"
 #include "plane_parallel.hpp"
@@ -601,6 +603,23 @@ PYBIND11_MODULE(_core, m) {
                  }
              }),
              py::arg("g"), py::arg("shape") = py::dict())
+        .def_static(
+            "for_quality",
+            [](double g, const std::string& quality) {
+                if (quality != "full" && quality != "preview")
+                    throw py::value_error("quality: must be \"full\" or \"preview\"");
+                const airlight::ParticleTableShape shape = airlight::particle_table_shape(
+                    quality == "full" ? airlight::ParticleTableQuality::full : airlight::ParticleTableQuality::preview);
+                py::gil_scoped_release release;
+                try {
+                    return std::make_unique<airlight::ParticleTable>(g, shape);
+                } catch (const std::invalid_argument& e) {
+                    py::gil_scoped_acquire acquire;
+                    throw py::value_error(e.what());
+                }
+            },
+            "The table the renderer builds for quality.particle_table (\"full\" or \"preview\").", py::arg("g"),
+            py::arg("quality"))
         .def_property_readonly("build_seconds", &airlight::ParticleTable::build_seconds)
         .def_property_readonly("bytes",
                                [](const airlight::ParticleTable& t) { return t.nodes().size() * sizeof(float); })
@@ -624,6 +643,54 @@ PYBIND11_MODULE(_core, m) {
                 return out;
             },
             py::arg("taus"), py::arg("normals"), py::arg("views"), py::arg("sun"));
+    // The particle clouds' particles of a scene's frame, as the shading pass reads them (nearest
+    // first; effects/particle_clouds/particle_field.hpp), with the modelling's counts and times: for
+    // the float64 compositing reference and the benchmark.
+    m.def(
+        "particle_frame",
+        [](py::handle scene_obj) {
+            const Scene scene = scene_from_python(scene_obj);
+            airlight::ParticleField field;
+            airlight::ParticleTiles tiles;
+            double bin_seconds = 0.0;
+            {
+                py::gil_scoped_release release;
+                const airlight::FrameData data = airlight::make_frame_data(scene);
+                const airlight::ParticleCamera cam = airlight::particle_camera(data);
+                field = airlight::particle_field(scene.particle_clouds, cam, glm::vec3(data.frame.sky.sun_direction));
+                const auto start = std::chrono::steady_clock::now();
+                tiles = airlight::bin_particles(field.particles, cam, airlight::shader::PARTICLE_TILE_SIZE);
+                bin_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+            }
+            const py::ssize_t n = py::ssize_t(field.particles.size());
+            py::array_t<double> center({n, py::ssize_t(3)});
+            py::array_t<double> radius(n), tau(n), sun(n), sky(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const airlight::Particle& p = field.particles[size_t(i)];
+                for (int k = 0; k < 3; ++k) center.mutable_data()[3 * i + k] = p.center[k];
+                radius.mutable_data()[i] = p.radius;
+                tau.mutable_data()[i] = p.tau;
+                sun.mutable_data()[i] = p.sun_transmittance;
+                sky.mutable_data()[i] = p.sky_visibility;
+            }
+            py::dict out;
+            out["center"] = center;
+            out["radius"] = radius;
+            out["tau"] = tau;
+            out["sun_transmittance"] = sun;
+            out["sky_visibility"] = sky;
+            const airlight::ParticleFieldStats& s = field.stats;
+            out["columns"] = s.columns;
+            out["particles"] = s.particles;
+            out["drawn"] = s.drawn;
+            out["tile_entries"] = tiles.entries.size();
+            out["model_seconds"] = s.model_seconds;
+            out["shadow_seconds"] = s.shadow_seconds;
+            out["sort_seconds"] = s.sort_seconds;
+            out["bin_seconds"] = bin_seconds;
+            return out;
+        },
+        py::arg("scene"));
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

@@ -25,11 +25,12 @@ void pack_daytime_frame(const Scene& scene, FrameData& data) {
     for (size_t k = 0; k < levels.size() && k < size_t(shader::ATMOSPHERE_MAX_LEVELS); ++k)
         f.atmosphere.levels[k / 4][int(k % 4)] = levels[k];
     // The table: with its columns for a sky that lights an atmosphere, C = 0
-    // only for one that lights surfaces or clouds (effects/noise_clouds)
+    // only for one that lights surfaces or clouds (effects/noise_clouds, particle_clouds)
     // through clear air.
     const bool columns = data.features.sky && data.features.atmosphere;
     const Table2D* sky_table = nullptr;
-    if (columns || (data.features.sky && (data.features.surfaces || clouds_visible(scene.clouds)))) {
+    if (columns || (data.features.sky && (data.features.surfaces || clouds_visible(scene.clouds) ||
+                                          particle_clouds_visible(scene.particle_clouds)))) {
         data.use_table(shader::TABLE_SKY_PHASE, sky_phase_table(f.sky, f.species, columns));
         sky_table = data.tables[shader::TABLE_SKY_PHASE];
     }

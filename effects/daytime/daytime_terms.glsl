@@ -75,6 +75,6 @@ vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
 // Hook view_transfer: the atmosphere along the whole view ray [0, t_hit]; with
 // clouds, their transfer calls atmosphere_segment_transfer around their layer instead.
 vec3 atmosphere_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
-    if (HAS_CLOUDS) return radiance;
+    if (HAS_CLOUDS || HAS_PARTICLE_CLOUDS) return radiance;
     return atmosphere_segment_transfer(origin, dir, 0.0f, t_hit, radiance, 1.0f);
 }

@@ -54,6 +54,6 @@ vec3 medium_sun_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
 // ray [0, t_hit]; with clouds, their transfer calls
 // medium_sun_segment_transfer around their layer instead.
 vec3 medium_sun_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
-    if (HAS_CLOUDS) return radiance;
+    if (HAS_CLOUDS || HAS_PARTICLE_CLOUDS) return radiance;
     return medium_sun_segment_transfer(origin, dir, 0.0f, t_hit, radiance, 1.0f);
 }

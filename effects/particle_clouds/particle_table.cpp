@@ -68,6 +68,24 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
     build_seconds_ = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
 
+ParticleTableShape particle_table_shape(ParticleTableQuality quality) {
+    ParticleTableShape shape;  // full: 12 optical radii (docs/table_resolution.txt)
+    shape.taus = 12;
+    if (quality == ParticleTableQuality::preview) {
+        shape.entry = 16;
+        shape.view_zenith = 8;
+        shape.view_azimuth = 16;
+        shape.taus = 8;
+        shape.steps = 16;
+        shape.grid.radii = 8;
+        shape.grid.polar = 12;
+        shape.grid.zenith = 12;
+        shape.grid.azimuth = 8;
+        shape.grid.march_steps = 8;
+    }
+    return shape;
+}
+
 double ParticleTable::slice_tau(int m) const {
     return shape_.tau_min * std::pow(shape_.tau_max / shape_.tau_min, double(m) / (shape_.taus - 1));
 }

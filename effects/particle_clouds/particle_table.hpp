@@ -8,6 +8,7 @@
 #include <array>
 #include <vector>
 
+#include "airlight/scene.hpp"
 #include "sphere_scattering.hpp"
 
 namespace airlight {
@@ -26,6 +27,9 @@ struct ParticleTableShape {
 
 // Throws std::invalid_argument naming the field when a shape is out of range.
 void validate_particle_table_shape(const ParticleTableShape& shape);
+
+// The shape the renderer builds for a quality setting (quality.particle_table).
+ParticleTableShape particle_table_shape(ParticleTableQuality quality);
 
 class ParticleTable {
 public:

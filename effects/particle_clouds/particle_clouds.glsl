@@ -1,0 +1,176 @@
+// The particle clouds' per-pixel functions (physics.md sections 3 and 6):
+// the lighting table's lookup and the compositing of a pixel's particles.
+
+// Texel k of a table laid out in rows of PARTICLE_ROW_TEXELS.
+vec4 particle_texel4(int table, int k) {
+    return table_texel4(table, k % PARTICLE_ROW_TEXELS, k / PARTICLE_ROW_TEXELS);
+}
+int particle_index_at(int k) {
+    return int(table_texel(TABLE_PARTICLE_TILES, k % PARTICLE_ROW_TEXELS, k / PARTICLE_ROW_TEXELS));
+}
+
+// One optical-radius slice m of the lighting table (eq. 3.1): its four
+// channels trilinear in the entry angle, view zenith and view azimuth
+// (nodes e, z, a and the fractions toward the next in f).
+vec4 particle_slice(int m, ivec3 node, vec3 f) {
+    ivec4 n = frame.particle_clouds.table_shape;
+    vec4 sum = vec4(0.0f);
+    for (int corner = 0; corner < 8; ++corner) {
+        int de = corner & 1;
+        int dz = (corner >> 1) & 1;
+        int da = (corner >> 2) & 1;
+        float w = (de == 1 ? f.x : 1.0f - f.x) * (dz == 1 ? f.y : 1.0f - f.y) * (da == 1 ? f.z : 1.0f - f.z);
+        int x = (node.z + da) + n.z * (node.y + dz);
+        int y = (node.x + de) + n.x * m;
+        sum += w * table_texel4(TABLE_PARTICLE_LIGHT, x, y);
+    }
+    return sum;
+}
+
+// The lower node of a fractional index on n nodes (clamped to [0, n - 2]) and the fraction past it.
+int particle_node(float x, int n, OUT(float) f) {
+    float c = clamp(x, 0.0f, float(n - 1));
+    int i = min(int(c), n - 2);
+    f = c - float(i);
+    return i;
+}
+
+// A Catmull-Rom cubic through b, c at f in [0, 1], a missing end (has_a,
+// has_d false) continued linearly (eq. 3.3).
+float particle_cubic(float a, float b, float c, float d, bool has_a, bool has_d, float f) {
+    if (!has_a) a = 2.0f * b - c;
+    if (!has_d) d = 2.0f * c - b;
+    float f2 = f * f;
+    float f3 = f2 * f;
+    return 0.5f * ((-f3 + 2.0f * f2 - f) * a + (3.0f * f3 - 5.0f * f2 + 2.0f) * b + (-3.0f * f3 + 4.0f * f2 + f) * c +
+                   (f3 - f2) * d);
+}
+
+// Across the slices (eq. 3.3): the cubic of the logarithm where all four are positive, else of the value clamped at 0.
+float particle_across_taus(float a, float b, float c, float d, bool has_a, bool has_d, float f) {
+    bool positive = b > 0.0f && c > 0.0f && (!has_a || a > 0.0f) && (!has_d || d > 0.0f);
+    if (positive)
+        return exp(particle_cubic(has_a ? log(a) : 0.0f, log(b), log(c), has_d ? log(d) : 0.0f, has_a, has_d, f));
+    return max(0.0f, particle_cubic(a, b, c, d, has_a, has_d, f));
+}
+
+// The light of a ray entering a particle of optical radius tau where its
+// outward normal is n, along unit v (v . n < 0), the sun toward s, per unit
+// sun irradiance, all orders (eq. 3.1-3.3; ParticleTable::lookup is the same
+// in double).
+float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
+    ivec4 shape = frame.particle_clouds.table_shape;
+    vec4 taus = frame.particle_clouds.table_taus;
+    float cos_entry = clamp(dot(n, s), -1.0f, 1.0f);
+    float cos_view = clamp(-dot(n, v), 0.0f, 1.0f);
+    vec3 t = s - cos_entry * n;
+    float psi = 0.0f;
+    if (dot(t, t) > 1.0e-12f) {
+        t = normalize(t);
+        psi = atan(abs(dot(v, cross(n, t))), dot(v, t));
+    }
+    vec3 f;
+    ivec3 node;
+    node.x = particle_node(precise_acos(cos_entry) / PI * float(shape.x - 1), shape.x, f.x);
+    float zenith = precise_acos(cos_view) / (0.5f * PI);
+    node.y = particle_node((1.0f - pow(max(1.0f - zenith, 0.0f), 1.0f / 1.5f)) * float(shape.y - 1), shape.y, f.y);
+    node.z = particle_node(psi / PI * float(shape.z - 1), shape.z, f.z);
+    float ft;
+    int m = particle_node(log(max(tau, 1.0e-30f) / taus.x) / taus.y * float(shape.w - 1), shape.w, ft);
+    bool below = m > 0;
+    bool above = m + 2 < shape.w;
+    vec4 v0 = particle_slice(m, node, f);
+    vec4 v1 = particle_slice(m + 1, node, f);
+    vec4 vm = below ? particle_slice(m - 1, node, f) : vec4(0.0f);
+    vec4 v2 = above ? particle_slice(m + 2, node, f) : vec4(0.0f);
+    // The channels: order 1 over its phase, orders 2 and 3's peaks over theirs, the rest (eq. 3.1).
+    float g = taus.z;
+    float mu = dot(s, v);
+    vec4 phases = vec4(0.0f, 0.0f, 0.0f, 1.0f);
+    phases.x = species_phase(vec4(g, 0.0f, 1.0f, 0.0f), mu);
+    phases.y = species_phase(vec4(g * g, 0.0f, 1.0f, 0.0f), mu);
+    phases.z = species_phase(vec4(g * g * g, 0.0f, 1.0f, 0.0f), mu);
+    float first = particle_across_taus(vm.x * phases.x, v0.x * phases.x, v1.x * phases.x, v2.x * phases.x, below,
+                                       above, ft);
+    float rest = particle_across_taus(dot(vec3(vm.y, vm.z, vm.w), vec3(phases.y, phases.z, 1.0f)),
+                                      dot(vec3(v0.y, v0.z, v0.w), vec3(phases.y, phases.z, 1.0f)),
+                                      dot(vec3(v1.y, v1.z, v1.w), vec3(phases.y, phases.z, 1.0f)),
+                                      dot(vec3(v2.y, v2.z, v2.w), vec3(phases.y, phases.z, 1.0f)), below, above, ft);
+    // Below the smallest slice: order 1 scales with tau, the rest with tau^2 (eq. 3.2).
+    float thin = min(1.0f, tau / taus.x);
+    return first * thin + rest * thin * thin;
+}
+
+// The screen tile holding the pixel whose ray is dir (the inverse of
+// camera_ray_direction), -1 off the film.
+int particle_tile_of(vec3 dir) {
+    vec3 r = vec3(frame.camera_right);
+    vec3 u = vec3(frame.camera_up);
+    float z = dot(dir, vec3(frame.camera_forward));
+    if (!(z > 0.0f)) return -1;
+    float sx = dot(dir, r) / (dot(r, r) * z);
+    float sy = dot(dir, u) / (dot(u, u) * z);
+    int x = int(floor(0.5f * (sx + 1.0f) * float(frame.film_width)));
+    int row = int(floor(0.5f * (1.0f - sy) * float(frame.film_height)));
+    if (x < 0 || row < 0 || x >= frame.film_width || row >= frame.film_height) return -1;
+    int size = frame.particle_clouds.tiles.w;
+    return (row / size) * frame.particle_clouds.tiles.x + x / size;
+}
+
+// The particles along [0, t_hit] of the ray origin + t dir, nearest centre
+// first (section 6): their light reaching the camera (light) and the
+// fraction of the light behind them they pass (through); t_half, the middle
+// of the visible chord of the particle where that fraction falls below 1/2
+// (of the last one where it never does; -1 where the ray meets none).
+void particle_composite(vec3 origin, vec3 dir, float t_hit, OUT(vec3) light, OUT(float) through,
+                        OUT(float) t_half) {
+    light = vec3(0.0f);
+    through = 1.0f;
+    t_half = -1.0f;
+    int tile = particle_tile_of(dir);
+    if (tile < 0) return;
+    int begin = particle_index_at(tile);
+    int end = particle_index_at(tile + 1);
+    int header = frame.particle_clouds.tiles.x * frame.particle_clouds.tiles.y + 1;
+    vec3 s = vec3(frame.sky.sun_direction);
+    bool sun = HAS_SUN && s.y > 0.0f;
+    bool crossed_half = false;
+    for (int k = begin; k < end; ++k) {
+        int i = particle_index_at(header + k);
+        vec4 sphere = particle_texel4(TABLE_PARTICLES, 2 * i);
+        vec4 lit = particle_texel4(TABLE_PARTICLES, 2 * i + 1);
+        // Eq. 6.1: the chord [t0, t1] and its visible part [a, e] (the camera inside, a surface cutting it).
+        vec3 oc = vec3(sphere) - origin;
+        float b = dot(oc, dir);
+        float R = sphere.w;
+        float h2 = R * R - dot(oc - b * dir, oc - b * dir);
+        if (!(h2 > 0.0f)) continue;
+        float h = sqrt(h2);
+        float a = max(b - h, 0.0f);
+        float e = min(b + h, t_hit);
+        if (!(e > a)) continue;
+        float sigma = lit.x / R;
+        float opacity = 1.0f - exp(-sigma * (e - a));
+        float chord_opacity = 1.0f - exp(-sigma * 2.0f * h);
+        // The chord's light scaled by the visible part's share of its opacity (eq. 6.2).
+        float share = chord_opacity > 1.0e-6f ? opacity / chord_opacity : (e - a) / (2.0f * h);
+        vec3 c = vec3(sphere);
+        vec3 own = vec3(0.0f);
+        if (sun && lit.y > 0.0f) {
+            vec3 n = (origin + (b - h) * dir - c) / R;
+            own += sun_irradiance(c, s) * (lit.y * share * particle_table_light(lit.x, n, dir, s));
+        }
+        // The sky's light (eq. 6.3): the mean radiance of the sky over the sphere of directions, seen
+        // through the others above, scattered in proportion to the opacity.
+        if (HAS_SKY) own += sky_irradiance(c, vec3(0.0f, 1.0f, 0.0f)) * (lit.z * opacity / (2.0f * PI));
+        light += through * own;
+        through *= 1.0f - opacity;
+        // The chord's middle, within its visible part (a camera inside the particle may be past it).
+        if (!crossed_half) t_half = clamp(b, a, e);
+        crossed_half = crossed_half || through < 0.5f;
+        if (through < PARTICLE_OPAQUE) {
+            through = 0.0f;
+            break;
+        }
+    }
+}

@@ -1,0 +1,137 @@
+// The particle clouds' part of the frame (physics.md sections 3-6): the
+// lighting table for the droplets' g (built once per process, kept on disk),
+// the frame's particles and the screen tiles' lists, as tables both backends
+// read; nothing for a scene without particle clouds.
+#include <algorithm>
+#include <cmath>
+#include <cstdio>
+#include <cstdlib>
+#include <filesystem>
+#include <fstream>
+#include <string>
+
+#include "frame_data.hpp"
+#include "particle_field.hpp"
+#include "particle_table.hpp"
+
+namespace airlight {
+
+namespace {
+
+// Bumped whenever the solver or the table's layout changes: older files on disk are ignored.
+constexpr int TABLE_FILE_VERSION = 1;
+
+// Where built tables are kept: $AIRLIGHT_CACHE_DIR, else $XDG_CACHE_HOME/airlight, else
+// ~/.cache/airlight; empty (no disk cache) when none can be named.
+std::filesystem::path cache_dir() {
+    if (const char* d = std::getenv("AIRLIGHT_CACHE_DIR"); d && *d) return d;
+    if (const char* d = std::getenv("XDG_CACHE_HOME"); d && *d) return std::filesystem::path(d) / "airlight";
+    if (const char* d = std::getenv("HOME"); d && *d) return std::filesystem::path(d) / ".cache" / "airlight";
+    return {};
+}
+
+// The lighting table as a texture (eq. 3.1): texel (a + A z, e + E m) holds node
+// [m][e][z][a], which is ParticleTable::nodes' order: the texels are the nodes.
+Table2D build_light_table(float g, ParticleTableQuality quality) {
+    const ParticleTableShape shape = particle_table_shape(quality);
+    Table2D t;
+    t.width = shape.view_azimuth * shape.view_zenith;
+    t.height = shape.entry * shape.taus;
+    t.channels = 4;
+    const size_t count = size_t(t.width) * t.height * 4;
+    char name[96];
+    std::snprintf(name, sizeof name, "particle_light_v%d_%s_g%.6f.bin", TABLE_FILE_VERSION,
+                  quality == ParticleTableQuality::full ? "full" : "preview", double(g));
+    const std::filesystem::path dir = cache_dir();
+    if (!dir.empty()) {
+        std::ifstream in(dir / name, std::ios::binary);
+        t.texels.resize(count);
+        if (in.read(reinterpret_cast<char*>(t.texels.data()), std::streamsize(count * sizeof(float))) &&
+            in.peek() == std::char_traits<char>::eof())
+            return t;
+    }
+    const ParticleTable table(g, shape);
+    t.texels = table.nodes();
+    if (!dir.empty()) {
+        // Written to a temporary name and renamed, so that a concurrent reader never sees half a file.
+        std::error_code ec;
+        std::filesystem::create_directories(dir, ec);
+        const std::filesystem::path part = dir / (std::string(name) + ".part" + std::to_string(std::rand()));
+        {
+            std::ofstream out(part, std::ios::binary);
+            out.write(reinterpret_cast<const char*>(t.texels.data()), std::streamsize(count * sizeof(float)));
+        }
+        std::filesystem::rename(part, dir / name, ec);
+        if (ec) std::filesystem::remove(part, ec);
+    }
+    return t;
+}
+
+std::shared_ptr<const Table2D> light_table(float g, ParticleTableQuality quality) {
+    static TableCache<std::pair<float, int>> cache(2);
+    return cache.get({g, int(quality)},
+                     [&] { return timed_build("particle_light", [&] { return build_light_table(g, quality); }); });
+}
+
+// A per-frame table of `texels` floats in rows of PARTICLE_ROW_TEXELS texels.
+std::shared_ptr<const Table2D> row_table(const char* name, int channels, std::vector<float> texels) {
+    auto t = std::make_shared<Table2D>();
+    t->name = name;
+    t->channels = channels;
+    const size_t n = texels.size() / size_t(channels);
+    t->width = shader::PARTICLE_ROW_TEXELS;
+    t->height = int(std::max<size_t>(1, (n + t->width - 1) / t->width));
+    texels.resize(size_t(t->width) * t->height * channels, 0.0f);
+    t->texels = std::move(texels);
+    t->serial = next_table_serial();
+    return t;
+}
+
+}  // namespace
+
+ParticleCamera particle_camera(const FrameData& data) {
+    ParticleCamera cam;
+    cam.position = glm::vec3(data.frame.camera_position);
+    cam.right = glm::vec3(data.frame.camera_right);
+    cam.up = glm::vec3(data.frame.camera_up);
+    cam.forward = glm::vec3(data.frame.camera_forward);
+    cam.width = data.frame.film_width;
+    cam.height = data.frame.film_height;
+    return cam;
+}
+
+void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
+    const ParticleClouds& c = scene.particle_clouds;
+    data.features.particle_clouds = particle_clouds_visible(c);
+    if (!data.features.particle_clouds) return;
+    const ParticleCamera cam = particle_camera(data);
+    const ParticleField field = particle_field(c, cam, glm::vec3(data.frame.sky.sun_direction));
+    // Brute force ("all"): one tile, the whole film, every pixel testing every particle.
+    const int tile_size = scene.quality.particle_compositing == ParticleCompositing::tiles
+                              ? shader::PARTICLE_TILE_SIZE
+                              : std::max(cam.width, cam.height);
+    const ParticleTiles tiles = bin_particles(field.particles, cam, tile_size);
+    std::vector<float> particles;
+    particles.reserve(field.particles.size() * 8);
+    for (const Particle& p : field.particles)
+        for (float v :
+             {p.center.x, p.center.y, p.center.z, p.radius, p.tau, p.sun_transmittance, p.sky_visibility, 0.0f})
+            particles.push_back(v);
+    // The tile table: the tiles' offsets (one more than the tiles), then the entries; indices are
+    // exact in float32 below 2^24 (PARTICLE_MAX_TILE_ENTRIES).
+    std::vector<float> lists;
+    lists.reserve(tiles.offsets.size() + tiles.entries.size());
+    for (int v : tiles.offsets) lists.push_back(float(v));
+    for (int v : tiles.entries) lists.push_back(float(v));
+    const ParticleTableShape shape = particle_table_shape(scene.quality.particle_table);
+    shader::ParticleCloudsGpu& g = data.frame.particle_clouds;
+    g.table_shape = glm::ivec4(shape.entry, shape.view_zenith, shape.view_azimuth, shape.taus);
+    g.table_taus = glm::vec4(float(shape.tau_min), float(std::log(shape.tau_max / shape.tau_min)), c.g, 0.0f);
+    g.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, int(field.particles.size()), tile_size);
+    if (particles.empty()) particles.assign(8, 0.0f);
+    data.use_table(shader::TABLE_PARTICLES, row_table("particles", 4, std::move(particles)));
+    data.use_table(shader::TABLE_PARTICLE_TILES, row_table("particle_tiles", 1, std::move(lists)));
+    data.use_table(shader::TABLE_PARTICLE_LIGHT, light_table(c.g, scene.quality.particle_table));
+}
+
+}  // namespace airlight

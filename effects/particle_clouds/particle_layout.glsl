@@ -1,0 +1,17 @@
+// The particle clouds' frame data (EFFECT_GLSL_LAYOUT; physics.md sections
+// 3 and 6): the lighting table's shape and the screen tiles' grid. The
+// particles and the tiles' lists are tables (particle_frame.cpp).
+
+// Texels per row of the particle and tile tables (two RGBA texels a particle).
+CONST int PARTICLE_ROW_TEXELS = 2048;
+// The screen tiles' edge in pixels (section 6; quality.particle_compositing "tiles").
+CONST int PARTICLE_TILE_SIZE = 16;
+// A pixel's compositing stops once the particles in front pass less than
+// this fraction of the light behind them (section 6).
+CONST float PARTICLE_OPAQUE = 1.0e-4f;
+
+struct ParticleCloudsGpu {
+    ivec4 table_shape;  // the lighting table's nodes: x entry angles, y view zeniths, z view azimuths, w optical radii
+    vec4 table_taus;    // x: the smallest optical radius, y: ln(largest / smallest), z: the droplets' g, w: unused
+    ivec4 tiles;        // x, y: screen tiles along x and down, z: particles, w: a tile's edge in pixels
+};
