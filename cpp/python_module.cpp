@@ -652,12 +652,15 @@ PYBIND11_MODULE(_core, m) {
             const Scene scene = scene_from_python(scene_obj);
             airlight::ParticleField field;
             airlight::ParticleTiles tiles;
+            std::vector<airlight::Particle> casters;
             double bin_seconds = 0.0;
             {
                 py::gil_scoped_release release;
                 const airlight::FrameData data = airlight::make_frame_data(scene);
                 const airlight::ParticleCamera cam = airlight::particle_camera(data);
-                field = airlight::particle_field(scene.particle_clouds, cam, glm::vec3(data.frame.sky.sun_direction));
+                const glm::vec3 sun(data.frame.sky.sun_direction);
+                field = airlight::particle_field(scene.particle_clouds, cam, sun);
+                casters = airlight::model_particles(scene.particle_clouds, cam.position, sun);
                 const auto start = std::chrono::steady_clock::now();
                 tiles = airlight::bin_particles(field.particles, cam, airlight::shader::PARTICLE_TILE_SIZE);
                 bin_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
@@ -688,6 +691,19 @@ PYBIND11_MODULE(_core, m) {
             out["shadow_seconds"] = s.shadow_seconds;
             out["sort_seconds"] = s.sort_seconds;
             out["bin_seconds"] = bin_seconds;
+            // Every particle, the culled ones too (the shadow casters: model_particles).
+            py::array_t<double> all_center({py::ssize_t(casters.size()), py::ssize_t(3)});
+            py::array_t<double> all_radius(py::ssize_t(casters.size())), all_tau(py::ssize_t(casters.size()));
+            for (size_t i = 0; i < casters.size(); ++i) {
+                for (int k = 0; k < 3; ++k) all_center.mutable_data()[3 * i + k] = casters[i].center[k];
+                all_radius.mutable_data()[i] = casters[i].radius;
+                all_tau.mutable_data()[i] = casters[i].tau;
+            }
+            py::dict all;
+            all["center"] = all_center;
+            all["radius"] = all_radius;
+            all["tau"] = all_tau;
+            out["casters"] = all;
             return out;
         },
         py::arg("scene"));

@@ -23,6 +23,8 @@ vec3 sun_surface_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) e += ms_sun_residual(ms_level(max(p.y, 0.0f))) * cos_n;
     // The clouds' shadow (effects/noise_clouds/physics.md section 5).
     if (HAS_CLOUDS) visible *= cloud_transmittance_from(p, vec3(frame.sky.sun_direction));
+    // The particle clouds' (effects/particle_clouds/physics.md section 5).
+    if (HAS_PARTICLE_CLOUDS) visible *= particle_sun_transmittance(p);
     return visible * e;
 }
 

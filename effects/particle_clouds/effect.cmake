@@ -18,7 +18,8 @@ set(EFFECT_FEATURES
 set(EFFECT_TABLES
     particle_light  # the lighting table (physics.md section 3): RGBA, (azimuth + A zenith, entry + E tau slice)
     particles       # the frame's particles, two RGBA texels each (centre, radius; tau, sun and sky transmittance)
-    particle_tiles) # the screen tiles' offsets, then their lists of particle indices
+    particle_tiles  # the screen tiles' offsets, then their lists of particle indices
+    particle_shadow) # the sun's transmittance through the particles from the plane below them
 set(EFFECT_FRAME 1)
 set(EFFECT_GLSL_LAYOUT particle_layout.glsl)
 set(EFFECT_UNIFORMS "ParticleCloudsGpu particle_clouds")

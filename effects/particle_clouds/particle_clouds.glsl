@@ -174,3 +174,19 @@ void particle_composite(vec3 origin, vec3 dir, float t_hit, OUT(vec3) light, OUT
         }
     }
 }
+
+// The sun's transmittance through the particles from p (section 5): the
+// shadow map on the plane below them, read where the ray from p toward the
+// sun crosses it (p above the plane: straight below p, the shadow of what
+// lies above the plane taken for all); 1 off the map.
+float particle_sun_transmittance(vec3 p) {
+    int n = frame.particle_clouds.shadow_size.x;
+    vec3 s = vec3(frame.sky.sun_direction);
+    if (n == 0 || !(s.y > 0.0f)) return 1.0f;
+    vec4 map = frame.particle_clouds.shadow_map;
+    float t = max((map.w - p.y) / s.y, 0.0f);
+    float u = (p.x + t * s.x - map.x) * map.z;
+    float v = (p.z + t * s.z - map.y) * map.z;
+    if (u < 0.0f || v < 0.0f || u > 1.0f || v > 1.0f) return 1.0f;
+    return table_bilinear(TABLE_PARTICLE_SHADOW, n, n, u, v);
+}

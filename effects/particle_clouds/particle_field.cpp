@@ -215,7 +215,7 @@ bool screen_rectangle(const Particle& p, const ParticleCamera& cam, int& x0, int
 }  // namespace
 
 std::vector<Particle> model_particles(const ParticleClouds& c, const glm::vec3& camera, const glm::vec3& sun,
-                                      ParticleFieldStats* stats) {
+                                      ParticleFieldStats* stats, ParticleShadowMap* shadow_map) {
     auto start = Clock::now();
     std::vector<Particle> out;
     if (!particle_clouds_visible(c)) return out;
@@ -304,13 +304,43 @@ std::vector<Particle> model_particles(const ParticleClouds& c, const glm::vec3& 
             p.sky_visibility = float(std::exp(-lattice.depth_above(q + double(p.radius) * up)));
         }
     });
+    // The shadow below (eq. 5.3): each sphere's chord along the sun's ray from every node of the map
+    // its shadow covers (within R / s_y of its centre's projection), summed exactly.
+    if (shadow_map && sun_up && !out.empty()) {
+        ParticleShadowMap& m = *shadow_map;
+        m.size = PARTICLE_SHADOW_MAP_SIZE;
+        m.x0 = lattice.origin.x;
+        m.z0 = lattice.origin.z;
+        m.extent = lattice.cell.x * lattice.nx;
+        m.plane = lattice.origin.y;
+        std::vector<double> depth(size_t(m.size) * m.size, 0.0);
+        const double texel = m.extent / (m.size - 1);
+        for (const Particle& p : out) {
+            const glm::dvec3 c(p.center);
+            const double R = p.radius, sigma = double(p.tau) / R;
+            const glm::dvec3 foot = c - ((c.y - m.plane) / s.y) * s;  // the centre's projection along the sun
+            const double reach = R / s.y;
+            const int i0 = std::max(0, int(std::ceil((foot.x - reach - m.x0) / texel)));
+            const int i1 = std::min(m.size - 1, int(std::floor((foot.x + reach - m.x0) / texel)));
+            const int j0 = std::max(0, int(std::ceil((foot.z - reach - m.z0) / texel)));
+            const int j1 = std::min(m.size - 1, int(std::floor((foot.z + reach - m.z0) / texel)));
+            for (int j = j0; j <= j1; ++j)
+                for (int i = i0; i <= i1; ++i) {
+                    const glm::dvec3 oc = c - glm::dvec3(m.x0 + i * texel, m.plane, m.z0 + j * texel);
+                    const double b = glm::dot(oc, s), h2 = R * R - (glm::dot(oc, oc) - b * b);
+                    if (h2 > 0.0) depth[size_t(j) * m.size + i] += sigma * 2.0 * std::sqrt(h2);
+                }
+        }
+        m.transmittance.resize(depth.size());
+        for (size_t k = 0; k < depth.size(); ++k) m.transmittance[k] = float(std::exp(-depth[k]));
+    }
     if (stats) stats->shadow_seconds = seconds_since(start);
     return out;
 }
 
 ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun) {
     ParticleField field;
-    std::vector<Particle> all = model_particles(clouds, camera.position, sun, &field.stats);
+    std::vector<Particle> all = model_particles(clouds, camera.position, sun, &field.stats, &field.shadow_map);
     const auto start = Clock::now();
     int x0, x1, y0, y1;
     for (Particle& p : all) {

@@ -39,8 +39,21 @@ struct ParticleFieldStats {
     double model_seconds = 0.0, shadow_seconds = 0.0, sort_seconds = 0.0, bin_seconds = 0.0;
 };
 
+// The particles' shadow below them (section 5): the sun's transmittance
+// through the lattice from each node of a square grid on the horizontal
+// plane y = plane (the lattice's bottom), node (i, j) at
+// (x0 + i extent / (size - 1), z0 + j extent / (size - 1)); empty when the
+// sun is below the horizon or there are no particles.
+struct ParticleShadowMap {
+    int size = 0;
+    double x0 = 0.0, z0 = 0.0, extent = 1.0, plane = 0.0;
+    std::vector<float> transmittance;  // size x size, row j at [j size, (j + 1) size)
+};
+constexpr int PARTICLE_SHADOW_MAP_SIZE = 256;
+
 struct ParticleField {
     std::vector<Particle> particles;  // the drawn ones, nearest centre first
+    ParticleShadowMap shadow_map;
     ParticleFieldStats stats;
 };
 
@@ -48,7 +61,7 @@ struct ParticleField {
 // the sun's and the sky's transmittance through the others (sun: unit, toward
 // the sun; below the horizon the sun's is 0).
 std::vector<Particle> model_particles(const ParticleClouds& clouds, const glm::vec3& camera, const glm::vec3& sun,
-                                      ParticleFieldStats* stats = nullptr);
+                                      ParticleFieldStats* stats = nullptr, ParticleShadowMap* shadow_map = nullptr);
 
 // The frame's particles: modelled, shadowed, culled to the view, sorted.
 ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun);

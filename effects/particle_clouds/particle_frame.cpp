@@ -128,6 +128,16 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
     g.table_shape = glm::ivec4(shape.entry, shape.view_zenith, shape.view_azimuth, shape.taus);
     g.table_taus = glm::vec4(float(shape.tau_min), float(std::log(shape.tau_max / shape.tau_min)), c.g, 0.0f);
     g.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, int(field.particles.size()), tile_size);
+    if (const ParticleShadowMap& m = field.shadow_map; m.size > 0) {
+        auto t = std::make_shared<Table2D>();
+        t->name = "particle_shadow";
+        t->width = t->height = m.size;
+        t->texels = m.transmittance;
+        t->serial = next_table_serial();
+        data.use_table(shader::TABLE_PARTICLE_SHADOW, std::move(t));
+        g.shadow_map = glm::vec4(float(m.x0), float(m.z0), float(1.0 / m.extent), float(m.plane));
+        g.shadow_size = glm::ivec4(m.size, 0, 0, 0);
+    }
     if (particles.empty()) particles.assign(8, 0.0f);
     data.use_table(shader::TABLE_PARTICLES, row_table("particles", 4, std::move(particles)));
     data.use_table(shader::TABLE_PARTICLE_TILES, row_table("particle_tiles", 1, std::move(lists)));

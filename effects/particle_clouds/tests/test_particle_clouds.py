@@ -245,3 +245,43 @@ def test_motion_changes_the_image_continuously(renderer_cache, motion):
     fine = mean_frame_difference(renderer, frames(10.0))
     assert coarse > 0  # it moves
     assert fine < 0.5 * coarse, (coarse, fine)
+
+
+# ---- The shadow below --------------------------------------------------------------------------
+
+def exact_sun_transmittance(points: np.ndarray, sun: np.ndarray, casters: dict[str, np.ndarray]) -> np.ndarray:
+    """exp(-sum of sigma x chord) over every particle the ray from each point toward the sun crosses."""
+    depth = np.zeros(len(points))
+    for c, r, tau in zip(casters["center"], casters["radius"], casters["tau"]):
+        oc = c - points
+        b = oc @ sun
+        h2 = r * r - (np.einsum("ij,ij->i", oc, oc) - b * b)
+        h = np.sqrt(np.maximum(h2, 0.0))
+        chord = np.clip(b + h, 0.0, None) - np.clip(b - h, 0.0, None)
+        depth += np.where(h2 > 0, tau / r * chord, 0.0)
+    return np.exp(-depth)
+
+
+def test_particles_shadow_the_ground_as_their_spheres_do(renderer):
+    """The ground's sunlight through the shadow map (every sphere's chord toward the sun summed at the
+    map's nodes on the plane below the particles, eq. 5.3) against the exact sum at each point seen:
+    measured median absolute error 4e-4, 90th percentile 1e-2 (bilinear between nodes 36 m apart at
+    the shadows' edges). Marching the lattice instead (cells of 300 m) gave 0.015 and 0.36."""
+    scene = with_particles()
+    del scene["sky"]
+    scene["surfaces"] = [{"type": "plane", "point": [0, 0, 0], "normal": [0, 1, 0], "albedo": 0.5}]
+    scene["camera"] = {"position": [0, 600, 0], "look_at": [0, 0, -700], "up": [0, 1, 0], "fov_y": 80}
+    out = renderer.render(scene, outputs=["radiance", "depth"])
+    clear = copy.deepcopy(scene)
+    clear["particle_clouds"]["coverage"] = 0
+    lit = renderer.render(clear)
+    seen = (out["depth"] < 1e5) & (lit[..., 1] > 0)
+    dirs = ref.camera_rays(scene)
+    points = np.asarray(scene["camera"]["position"], float) + dirs[seen] * out["depth"][seen][:, None]
+    el, az = np.radians(scene["sun"]["elevation"]), np.radians(scene["sun"]["azimuth"])
+    sun = np.array([np.cos(el) * np.sin(az), np.sin(el), -np.cos(el) * np.cos(az)])
+    exact = exact_sun_transmittance(points, sun, airlight._core.particle_frame(scene)["casters"])
+    got = out["radiance"][..., 1][seen] / lit[..., 1][seen]
+    assert exact.min() < 0.5 and exact.max() > 0.9  # shadow and light on the ground
+    err = np.abs(got - exact)
+    assert np.median(err) < 5e-3 and np.percentile(err, 90) < 0.05, (np.median(err), np.percentile(err, 90))
