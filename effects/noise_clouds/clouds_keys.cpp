@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "cloud_layer_keys.hpp"
 #include "scene_keys.hpp"
 #include "weather_map.hpp"
 
@@ -46,9 +47,31 @@ WeatherMap parse_weather_map(const SceneObject& o) {
 }
 
 Clouds parse_clouds(const SceneObject& o) {
-    o.check_keys({"base", "top", "coverage", "type", "extinction", "albedo", "g", "second_g", "second_weight", "powder",
-                  "erosion", "shape_scale", "detail_scale", "wind", "time", "seed", "weather_map"});
+    o.check_keys(cloud_layer_keys_and(
+        {"type", "albedo", "g", "second_g", "second_weight", "powder", "erosion", "detail_scale", "weather_map"}));
     Clouds c;
+    parse_cloud_layer(o, c);
+    if (auto v = o.opt("type")) c.type = read_in_range(*v, 0.0, 1.0);
+    if (auto v = o.opt("albedo")) c.albedo = read_in_range(*v, 0.0, 1.0);
+    if (auto v = o.opt("g")) c.g = read_asymmetry(*v);
+    if (auto v = o.opt("second_g")) c.second_g = read_asymmetry(*v);
+    if (auto v = o.opt("second_weight")) c.second_weight = read_in_range(*v, 0.0, 1.0);
+    if (auto v = o.opt("powder")) c.powder = read_in_range(*v, 0.0, 1.0);
+    if (auto v = o.opt("erosion")) c.erosion = read_in_range(*v, 0.0, 0.95);
+    if (auto v = o.opt("detail_scale")) c.detail_scale = read_in_range(*v, 0.1, 1e7, " m");
+    if (auto v = o.opt("weather_map"); v && !v->j.is_null()) c.weather_map = parse_weather_map(SceneObject(*v));
+    return c;
+}
+
+}  // namespace
+
+Names cloud_layer_keys_and(Names own) {
+    Names keys{"base", "top", "coverage", "extinction", "shape_scale", "wind", "time", "seed"};
+    keys.insert(keys.end(), own.begin(), own.end());
+    return keys;
+}
+
+void parse_cloud_layer(const SceneObject& o, CloudLayer& c) {
     c.present = true;
     if (auto v = o.opt("base")) c.base = read_in_range(*v, 0.0, 1e5, " m");
     if (auto v = o.opt("top")) {
@@ -58,16 +81,8 @@ Clouds parse_clouds(const SceneObject& o) {
         fail(Kind::value, join_path(o.path, "base"), "must be below the top (" + std::to_string(c.top) + " m)");
     }
     if (auto v = o.opt("coverage")) c.coverage = read_in_range(*v, 0.0, 1.0);
-    if (auto v = o.opt("type")) c.type = read_in_range(*v, 0.0, 1.0);
     if (auto v = o.opt("extinction")) c.extinction = read_in_range(*v, 0.0, 1e3, " 1/m");
-    if (auto v = o.opt("albedo")) c.albedo = read_in_range(*v, 0.0, 1.0);
-    if (auto v = o.opt("g")) c.g = read_asymmetry(*v);
-    if (auto v = o.opt("second_g")) c.second_g = read_asymmetry(*v);
-    if (auto v = o.opt("second_weight")) c.second_weight = read_in_range(*v, 0.0, 1.0);
-    if (auto v = o.opt("powder")) c.powder = read_in_range(*v, 0.0, 1.0);
-    if (auto v = o.opt("erosion")) c.erosion = read_in_range(*v, 0.0, 0.95);
     if (auto v = o.opt("shape_scale")) c.shape_scale = read_in_range(*v, 1.0, 1e7, " m");
-    if (auto v = o.opt("detail_scale")) c.detail_scale = read_in_range(*v, 0.1, 1e7, " m");
     if (auto v = o.opt("wind")) {
         if (!v->j.is_array() || v->j.size() != 2)
             fail(Kind::type, v->field, "expected [vx, vz] (m/s), got " + type_name(v->j));
@@ -76,11 +91,18 @@ Clouds parse_clouds(const SceneObject& o) {
     }
     if (auto v = o.opt("time")) c.time = read_in_range(*v, -1e7, 1e7, " s");
     if (auto v = o.opt("seed")) c.seed = read_int(*v, 0, 1 << 30);
-    if (auto v = o.opt("weather_map"); v && !v->j.is_null()) c.weather_map = parse_weather_map(SceneObject(*v));
-    return c;
 }
 
-}  // namespace
+void write_cloud_layer(const CloudLayer& c, json& j) {
+    j["base"] = json_number(c.base);
+    j["top"] = json_number(c.top);
+    j["coverage"] = json_number(c.coverage);
+    j["extinction"] = json_number(c.extinction);
+    j["shape_scale"] = json_number(c.shape_scale);
+    j["wind"] = json::array({json_number(c.wind_x), json_number(c.wind_z)});
+    j["time"] = json_number(c.time);
+    j["seed"] = c.seed;
+}
 
 // Rain falls from the cloud base (physics.md section 7): an atmosphere's rain
 // without its own "top" reaches up to the layer's base. Runs after the daytime
@@ -105,22 +127,15 @@ void write_noise_clouds_keys(const Scene& s, json& j) {
         return;
     }
     const Clouds& c = s.clouds;
-    j["clouds"] = {{"base", json_number(c.base)},
-                   {"top", json_number(c.top)},
-                   {"coverage", json_number(c.coverage)},
-                   {"type", json_number(c.type)},
-                   {"extinction", json_number(c.extinction)},
+    j["clouds"] = {{"type", json_number(c.type)},
                    {"albedo", json_number(c.albedo)},
                    {"g", json_number(c.g)},
                    {"second_g", json_number(c.second_g)},
                    {"second_weight", json_number(c.second_weight)},
                    {"powder", json_number(c.powder)},
                    {"erosion", json_number(c.erosion)},
-                   {"shape_scale", json_number(c.shape_scale)},
-                   {"detail_scale", json_number(c.detail_scale)},
-                   {"wind", json::array({json_number(c.wind_x), json_number(c.wind_z)})},
-                   {"time", json_number(c.time)},
-                   {"seed", c.seed}};
+                   {"detail_scale", json_number(c.detail_scale)}};
+    write_cloud_layer(c, j["clouds"]);
     if (c.weather_map.texels) {
         const WeatherMap& m = c.weather_map;
         j["clouds"]["weather_map"] = {{"image", m.image},

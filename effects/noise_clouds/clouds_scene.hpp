@@ -22,27 +22,36 @@ struct WeatherMap {
     float max_coverage = 1.0f;              // the largest red texel: 0 means the map clears the sky
 };
 
-// A layer of cloud between two altitudes whose density comes from two tiling
-// noise textures (physics.md sections 1 and 2).
-struct Clouds {
+// What both cloud methods' keys share ("clouds" here, "particle_clouds" in
+// effects/particle_clouds): a layer between two altitudes, how much of the
+// sky it covers, its extinction, its density texture's tile, its drift with
+// the wind and its seed, read and written by one function
+// (cloud_layer_keys.hpp).
+struct CloudLayer {
     bool present = false;
-    float base = 1500.0f;         // m: the layer's bottom (density 0 there)
+    float base = 1500.0f;         // m: the layer's bottom
     float top = 4000.0f;          // m: its top
-    float coverage = 0.5f;        // [0, 1]: the fraction of the sky the layer covers (0: none; x the weather map's R)
-    float type = 0.5f;            // [0, 1]: the height profile, 0 stratus, 0.5 cumulus, 1 cumulonimbus (or the map's G)
+    float coverage = 0.5f;        // [0, 1]: the fraction of the sky the layer covers (0: none)
     float extinction = 0.05f;     // 1/m: sigma_t at density 1
+    float shape_scale = 8000.0f;  // m: the shape (density) texture's tile
+    float wind_x = 0.0f;          // m/s: the field's drift along x
+    float wind_z = 0.0f;          // m/s: along z
+    float time = 0.0f;            // s: the field has drifted by wind * time
+    int seed = 0;                 // the noise textures' seed
+};
+
+// A layer of cloud between two altitudes whose density comes from two tiling
+// noise textures (physics.md sections 1 and 2); its coverage is scaled by the
+// weather map's R where there is one.
+struct Clouds : CloudLayer {
+    float type = 0.5f;            // [0, 1]: the height profile, 0 stratus, 0.5 cumulus, 1 cumulonimbus (or the map's G)
     float albedo = 1.0f;          // single-scattering albedo (water droplets: 1)
     float g = 0.2f;               // Henyey-Greenstein asymmetry of the droplets' lobe
     float second_g = -0.3f;       // an optional second lobe's asymmetry (physics.md eq. 3.4)
     float second_weight = 0.0f;   // [0, 1]: that lobe's share of the phase function (0: one lobe)
     float powder = 0.0f;          // [0, 1]: the powder term's strength (eq. 3.5; 0: physical)
     float erosion = 0.35f;        // [0, 1]: how far the detail noise eats into the edges (eq. 2.4)
-    float shape_scale = 8000.0f;  // m: the shape texture's tile
     float detail_scale = 600.0f;  // m: the detail texture's tile
-    float wind_x = 0.0f;          // m/s: the field's drift along x
-    float wind_z = 0.0f;          // m/s: along z
-    float time = 0.0f;            // s: the field has drifted by wind * time
-    int seed = 0;                 // the noise textures' seed
     WeatherMap weather_map;       // optional: coverage and type varying over the ground
 };
 

@@ -8,26 +8,17 @@ namespace airlight {
 // texture tiled over nested square rings of cells around the viewer, each
 // ring's cells twice the size of the one inside it; the cells above a
 // threshold extruded upward into voxels whose density falls with height;
-// one particle per occupied voxel. The keys shared with "clouds" (base, top,
-// coverage, extinction, g, shape_scale, wind, time, seed) mean the same.
-struct ParticleClouds {
-    bool present = false;
-    float base = 1500.0f;          // m: the layer's bottom
-    float top = 3500.0f;           // m: its top (the tallest column reaches it)
-    float coverage = 0.5f;         // [0, 1]: how much of the density texture becomes cloud (0: none)
-    float threshold = 0.1f;        // [0, 1): a column is cloud where its density exceeds this
-    float extinction = 0.05f;      // 1/m: sigma_t at density 1
-    float g = 0.85f;               // Henyey-Greenstein asymmetry of the droplets (the table's)
-    float cell_size = 200.0f;      // m: the innermost ring's cells (and voxels)
-    int ring_cells = 16;           // cells from the viewer to the edge of each ring (in that ring's cells)
-    int rings = 4;                 // nested rings; ring k's cells are cell_size 2^k
-    float particle_size = 0.75f;   // a particle's radius over its voxel's edge
-    float shape_scale = 8000.0f;   // m: the density texture's tile
-    float detail_scale = 1500.0f;  // m: the tile of the noise that perturbs the voxels' density
-    float wind_x = 0.0f;           // m/s: the field's drift along x
-    float wind_z = 0.0f;           // m/s: along z
-    float time = 0.0f;             // s: the field has drifted by wind * time
-    int seed = 0;                  // the textures' seed
+// one particle per occupied voxel. The keys shared with "clouds" (CloudLayer,
+// effects/noise_clouds/clouds_scene.hpp) mean the same.
+struct ParticleClouds : CloudLayer {
+    ParticleClouds() { top = 3500.0f; }  // the tallest column reaches the top
+    float threshold = 0.1f;              // [0, 1): a column is cloud where its density exceeds this
+    float g = 0.85f;                     // Henyey-Greenstein asymmetry of the droplets (the table's)
+    float cell_size = 200.0f;            // m: the innermost ring's cells (and voxels)
+    int ring_cells = 16;                 // cells from the viewer to the edge of each ring (in that ring's cells)
+    int rings = 4;                       // nested rings; ring k's cells are cell_size 2^k
+    float particle_size = 0.75f;         // a particle's radius over its voxel's edge
+    float detail_scale = 1500.0f;        // m: the tile of the noise that perturbs the voxels' density
 };
 
 // Particle clouds that can be seen: some coverage and extinction (a scene

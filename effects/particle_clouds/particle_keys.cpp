@@ -4,6 +4,7 @@
 // cpp/scene_keys.hpp).
 #include <string>
 
+#include "cloud_layer_keys.hpp"
 #include "particle_field.hpp"
 #include "scene_keys.hpp"
 
@@ -19,20 +20,11 @@ const NameTable<ParticleCompositing> compositings{{"tiles", ParticleCompositing:
                                                   {"all", ParticleCompositing::all}};
 
 ParticleClouds parse_particle_clouds(const SceneObject& o) {
-    o.check_keys({"base", "top", "coverage", "threshold", "extinction", "g", "cell_size", "ring_cells", "rings",
-                  "particle_size", "shape_scale", "detail_scale", "wind", "time", "seed"});
+    o.check_keys(
+        cloud_layer_keys_and({"threshold", "g", "cell_size", "ring_cells", "rings", "particle_size", "detail_scale"}));
     ParticleClouds c;
-    c.present = true;
-    if (auto v = o.opt("base")) c.base = read_in_range(*v, 0.0, 1e5, " m");
-    if (auto v = o.opt("top")) {
-        c.top = read_in_range(*v, 0.0, 1e5, " m");
-        if (!(c.top > c.base)) fail(Kind::value, v->field, "must be above the base (" + std::to_string(c.base) + " m)");
-    } else if (!(c.top > c.base)) {
-        fail(Kind::value, join_path(o.path, "base"), "must be below the top (" + std::to_string(c.top) + " m)");
-    }
-    if (auto v = o.opt("coverage")) c.coverage = read_in_range(*v, 0.0, 1.0);
+    parse_cloud_layer(o, c);
     if (auto v = o.opt("threshold")) c.threshold = read_in_range(*v, 0.0, 0.99);
-    if (auto v = o.opt("extinction")) c.extinction = read_in_range(*v, 0.0, 1e3, " 1/m");
     if (auto v = o.opt("g")) c.g = read_in_range(*v, 0.0, 0.95);
     if (auto v = o.opt("cell_size")) c.cell_size = read_in_range(*v, 1.0, 1e5, " m");
     if (auto v = o.opt("ring_cells")) c.ring_cells = read_int(*v, 2, 512);
@@ -44,16 +36,7 @@ ParticleClouds parse_particle_clouds(const SceneObject& o) {
              "rings x (2 ring_cells + 3)^2 = " + std::to_string(cells) + " cells, more than " +
                  std::to_string(PARTICLE_MAX_CELLS) + "; lower ring_cells or rings");
     if (auto v = o.opt("particle_size")) c.particle_size = read_in_range(*v, 0.1, 4.0);
-    if (auto v = o.opt("shape_scale")) c.shape_scale = read_in_range(*v, 1.0, 1e7, " m");
     if (auto v = o.opt("detail_scale")) c.detail_scale = read_in_range(*v, 1.0, 1e7, " m");
-    if (auto v = o.opt("wind")) {
-        if (!v->j.is_array() || v->j.size() != 2)
-            fail(Kind::type, v->field, "expected [vx, vz] (m/s), got " + type_name(v->j));
-        c.wind_x = read_in_range(Value{v->j[0], index_path(v->field, 0)}, -1e3, 1e3, " m/s");
-        c.wind_z = read_in_range(Value{v->j[1], index_path(v->field, 1)}, -1e3, 1e3, " m/s");
-    }
-    if (auto v = o.opt("time")) c.time = read_in_range(*v, -1e7, 1e7, " s");
-    if (auto v = o.opt("seed")) c.seed = read_int(*v, 0, 1 << 30);
     return c;
 }
 
@@ -75,21 +58,14 @@ void write_particle_clouds_keys(const Scene& s, json& j) {
         return;
     }
     const ParticleClouds& c = s.particle_clouds;
-    j["particle_clouds"] = {{"base", json_number(c.base)},
-                            {"top", json_number(c.top)},
-                            {"coverage", json_number(c.coverage)},
-                            {"threshold", json_number(c.threshold)},
-                            {"extinction", json_number(c.extinction)},
+    j["particle_clouds"] = {{"threshold", json_number(c.threshold)},
                             {"g", json_number(c.g)},
                             {"cell_size", json_number(c.cell_size)},
                             {"ring_cells", c.ring_cells},
                             {"rings", c.rings},
                             {"particle_size", json_number(c.particle_size)},
-                            {"shape_scale", json_number(c.shape_scale)},
-                            {"detail_scale", json_number(c.detail_scale)},
-                            {"wind", json::array({json_number(c.wind_x), json_number(c.wind_z)})},
-                            {"time", json_number(c.time)},
-                            {"seed", c.seed}};
+                            {"detail_scale", json_number(c.detail_scale)}};
+    write_cloud_layer(c, j["particle_clouds"]);
 }
 
 void parse_particle_clouds_quality(const SceneObject& quality, Scene& s) {

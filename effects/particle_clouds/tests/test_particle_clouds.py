@@ -249,7 +249,8 @@ def test_motion_changes_the_image_continuously(renderer_cache, motion):
 
 # ---- The shadow below --------------------------------------------------------------------------
 
-def exact_sun_transmittance(points: np.ndarray, sun: np.ndarray, casters: dict[str, np.ndarray]) -> np.ndarray:
+def exact_sun_transmittance(points: np.ndarray, sun: np.ndarray,
+                            casters: dict[str, np.ndarray]) -> np.ndarray:
     """exp(-sum of sigma x chord) over every particle the ray from each point toward the sun crosses."""
     depth = np.zeros(len(points))
     for c, r, tau in zip(casters["center"], casters["radius"], casters["tau"]):
