@@ -69,7 +69,7 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
 }
 
 ParticleTableShape particle_table_shape(ParticleTableQuality quality) {
-    ParticleTableShape shape;  // full: 12 optical radii (docs/table_resolution.txt)
+    ParticleTableShape shape;  // full: 12 optical radii (effects/particle_clouds/docs/table_resolution.txt)
     shape.taus = 12;
     if (quality == ParticleTableQuality::preview) {
         shape.entry = 16;
