@@ -319,7 +319,8 @@ def test_gl_pixels_recomputed_on_the_cpu_keep_their_outputs(renderer_cache) -> N
 def test_outputs_lists_and_describes_every_output() -> None:
     assert list(airlight.OUTPUTS)[:5] == ["radiance", "depth", "distance_z", "normal", "transmittance"]
     assert set(airlight.LAYERS) == {
-        "surfaces", "lamps", "spots", "rainbow", "atmospheric_light", "sky", "medium_sun", "clouds"}
+        "surfaces", "lamps", "spots", "rainbow", "atmospheric_light", "sky", "medium_sun", "clouds",
+        "particle_clouds"}
     assert all(len(text) > 20 for text in airlight.OUTPUTS.values())
 
 
