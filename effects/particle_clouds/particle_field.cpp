@@ -338,9 +338,11 @@ std::vector<Particle> model_particles(const ParticleClouds& c, const glm::vec3& 
     return out;
 }
 
-ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun) {
+ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun,
+                             bool shadow_map) {
     ParticleField field;
-    std::vector<Particle> all = model_particles(clouds, camera.position, sun, &field.stats, &field.shadow_map);
+    std::vector<Particle> all =
+        model_particles(clouds, camera.position, sun, &field.stats, shadow_map ? &field.shadow_map : nullptr);
     const auto start = Clock::now();
     int x0, x1, y0, y1;
     for (Particle& p : all) {

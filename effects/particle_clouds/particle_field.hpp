@@ -63,8 +63,11 @@ struct ParticleField {
 std::vector<Particle> model_particles(const ParticleClouds& clouds, const glm::vec3& camera, const glm::vec3& sun,
                                       ParticleFieldStats* stats = nullptr, ParticleShadowMap* shadow_map = nullptr);
 
-// The frame's particles: modelled, shadowed, culled to the view, sorted.
-ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun);
+// The frame's particles: modelled, shadowed, culled to the view, sorted; with
+// the shadow map where `shadow_map` (a scene with surfaces that could be in
+// their shadow).
+ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera& camera, const glm::vec3& sun,
+                             bool shadow_map = true);
 
 // Screen tiles of PARTICLE_TILE_SIZE pixels: for tile k (row-major), its list
 // of particle indices (into the sorted array, ascending: nearest first) in

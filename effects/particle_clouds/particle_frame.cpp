@@ -105,7 +105,8 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
     data.features.particle_clouds = particle_clouds_visible(c);
     if (!data.features.particle_clouds) return;
     const ParticleCamera cam = particle_camera(data);
-    const ParticleField field = particle_field(c, cam, glm::vec3(data.frame.sky.sun_direction));
+    // The shadow map only where surfaces may lie in the particles' shadow (physics.md section 5).
+    const ParticleField field = particle_field(c, cam, glm::vec3(data.frame.sky.sun_direction), data.features.surfaces);
     // Brute force ("all"): one tile, the whole film, every pixel testing every particle.
     const int tile_size = scene.quality.particle_compositing == ParticleCompositing::tiles
                               ? shader::PARTICLE_TILE_SIZE
