@@ -1,6 +1,6 @@
 # The core's part of the registry (cmake/effects.cmake): scene loading,
 # camera, surfaces and their BVH, the homogeneous medium, the backends.
-set(EFFECT_SOURCES scene_io.cpp scene_keys.cpp frame_data.cpp tables.cpp colour.cpp cpu_backend.cpp renderer.cpp
+set(EFFECT_SOURCES scene_io.cpp scene_keys.cpp frame_data.cpp tables.cpp screen_tiles.cpp colour.cpp cpu_backend.cpp renderer.cpp
     render_outputs.cpp image_io.cpp)
 # Constants and the core's structs come before every effect's layout (then
 # shaders/frame.glsl, FrameUniforms, and every effect's formulas).

@@ -25,7 +25,8 @@ inline constexpr const char kGlslPrelude[] =
     "#define OUT(T) out T\n"
     "#define INOUT(T) inout T\n"
     "#define INLINE\n"
-    "#define PRECISE precise\n";
+    "#define PRECISE precise\n"
+    "#define DECLARE(signature) signature;\n";
 
 // A compiled shader of `stage`; throws std::runtime_error with the log on failure.
 GLuint compile_shader(GLenum stage, const std::string& source);

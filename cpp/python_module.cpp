@@ -22,6 +22,8 @@
 #include "airlight/renderer.hpp"
 #include "airlight/scene_io.hpp"
 #include "airlight_tables.hpp"
+#include "drop_optics.hpp"
+#include "drops.hpp"
 #include "frame_data.hpp"
 #include "noise.hpp"
 #include "particle_field.hpp"
@@ -651,7 +653,7 @@ PYBIND11_MODULE(_core, m) {
         [](py::handle scene_obj) {
             const Scene scene = scene_from_python(scene_obj);
             airlight::ParticleField field;
-            airlight::ParticleTiles tiles;
+            airlight::ScreenTiles tiles;
             std::vector<airlight::Particle> casters;
             double bin_seconds = 0.0;
             {
@@ -707,6 +709,61 @@ PYBIND11_MODULE(_core, m) {
             return out;
         },
         py::arg("scene"));
+    // The falling rain's drops (effects/falling_rain/drops.hpp): every drop within its draw
+    // distance of the camera at the middle of the exposure, in any direction (the frame keeps
+    // those whose streaks reach the film), for the tests of the rain field and the benchmark.
+    m.def(
+        "rain_drops",
+        [](py::handle scene_obj) {
+            const Scene scene = scene_from_python(scene_obj);
+            std::vector<airlight::RainDrop> drops;
+            {
+                py::gil_scoped_release release;
+                drops = airlight::rain_drops(scene.falling_rain, glm::dvec3(scene.camera.position),
+                                             scene.camera.exposure_time);
+            }
+            const py::ssize_t n = py::ssize_t(drops.size());
+            py::array_t<double> position({n, py::ssize_t(3)}), velocity({n, py::ssize_t(3)});
+            py::array_t<double> diameter(n), weight(n);
+            py::array_t<std::uint64_t> id(n);
+            for (py::ssize_t i = 0; i < n; ++i) {
+                const airlight::RainDrop& d = drops[size_t(i)];
+                for (int k = 0; k < 3; ++k) {
+                    position.mutable_data()[3 * i + k] = d.position[k];
+                    velocity.mutable_data()[3 * i + k] = d.velocity[k];
+                }
+                diameter.mutable_data()[i] = d.diameter;
+                weight.mutable_data()[i] = d.weight;
+                id.mutable_data()[i] = d.id;
+            }
+            py::dict out;
+            out["position"] = position;
+            out["velocity"] = velocity;
+            out["diameter"] = diameter;
+            out["weight"] = weight;
+            out["id"] = id;
+            return out;
+        },
+        py::arg("scene"));
+    m.def("rain_terminal_speed", &airlight::terminal_speed, py::arg("diameter_mm"));
+    m.def("rain_draw_distance", [](py::handle scene_obj, double d) {
+        return airlight::rain_draw_distance(scene_from_python(scene_obj).falling_rain, d);
+    }, py::arg("scene"), py::arg("diameter_mm"));
+    m.def(
+        "drop_phase_order",
+        [](double n, int p, int bins, int samples) {
+            if (!(n > 1.0 && n < 2.0)) throw py::value_error("n: must be in (1, 2)");
+            if (p < 0 || p > 32) throw py::value_error("p: must be in [0, 32]");
+            if (bins < 1 || bins > 100000) throw py::value_error("bins: must be in [1, 100000]");
+            if (samples < 1 || samples > (1 << 26)) throw py::value_error("samples: must be in [1, 2^26]");
+            const std::vector<double> f = airlight::drop_phase_order(n, p, bins, samples);
+            py::array_t<double> out(py::ssize_t(f.size()));
+            std::memcpy(out.mutable_data(), f.data(), f.size() * sizeof(double));
+            return out;
+        },
+        py::arg("n"), py::arg("p"), py::arg("bins"), py::arg("samples"));
+    m.def("drop_order_energy", &airlight::drop_order_energy, py::arg("n"), py::arg("p"), py::arg("incidence"));
+    m.attr("DROP_ORDERS") = airlight::DROP_ORDERS;
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

@@ -86,12 +86,13 @@ Film parse_film(const SceneObject& o) {
 }
 
 Camera parse_camera(const SceneObject& o) {
-    o.check_keys({"position", "look_at", "up", "fov_y"});
+    o.check_keys({"position", "look_at", "up", "fov_y", "exposure_time"});
     Camera c;
     c.position = read_vec3(o.req("position"));
     c.look_at = read_vec3(o.req("look_at"));
     c.up = read_vec3(o.req("up"));
     c.fov_y_degrees = read_positive(o.req("fov_y"), 180.0, false);
+    if (auto v = o.opt("exposure_time")) c.exposure_time = read_in_range(*v, 0.0, 10.0, " s");
     // Degeneracy, on the stored float values.
     glm::dvec3 position(c.position), view = glm::dvec3(c.look_at) - position, up(c.up);
     // The view direction must stand above the float32 rounding of the two
@@ -309,7 +310,8 @@ json scene_to_json_value(const Scene& s) {
     j["camera"] = {{"position", json_vec3(s.camera.position)},
                    {"look_at", json_vec3(s.camera.look_at)},
                    {"up", json_vec3(s.camera.up)},
-                   {"fov_y", json_number(s.camera.fov_y_degrees)}};
+                   {"fov_y", json_number(s.camera.fov_y_degrees)},
+                   {"exposure_time", json_number(s.camera.exposure_time)}};
     if (s.has_medium) {
         // By its visibility where the scene gave one and sigma_t is still its value.
         const bool by_visibility =

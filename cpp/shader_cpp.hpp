@@ -21,6 +21,9 @@ using namespace glm;
 // GLSL's `precise`: no contraction of a product and a sum into one fused multiply-add, so that the GPU rounds
 // as the CPU build does (which targets x86-64 without FMA instructions).
 #define PRECISE
+// A function's prototype, for a call that comes before the function in the shared GLSL's order
+// (GLSL needs it; C++ member functions see each other without one).
+#define DECLARE(signature)
 
 #include "airlight_glsl_math.inc"
 

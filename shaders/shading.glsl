@@ -21,9 +21,11 @@ vec3 view_ray(vec3 origin, vec3 dir, float t_hit, vec3 n, vec3 radiance) {
     return hooks_view_segment(origin, dir, t_hit, radiance);
 }
 
-// Radiance arriving at the camera along the ray origin + t dir (lamp cores
-// smaller than a pixel excepted: hooks_pixel_cores).
-vec3 ray_radiance(vec3 origin, vec3 dir) {
+// Radiance arriving at `origin` along the ray origin + t dir (lamp cores
+// smaller than a pixel excepted: hooks_pixel_cores); with `emitters` false,
+// the lamps' and spots' own spheres are left out (the light an effect sums
+// from the lamps directly: the falling rain's environment).
+vec3 environment_radiance(vec3 origin, vec3 dir, bool emitters) {
     int hit_index = -1;
     vec3 normal = vec3(0.0f, 1.0f, 0.0f);
     float t_hit = NO_HIT;
@@ -32,7 +34,7 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     // An emitter (a lamp's sphere) in front of the first surface shows its own radiance.
     bool emitter = false;
     vec3 emitted = vec3(0.0f);
-    hooks_emitter_hit(origin, dir, t_hit, emitted, emitter);
+    if (emitters) hooks_emitter_hit(origin, dir, t_hit, emitted, emitter);
 
     vec3 radiance;
     if (emitter) {
@@ -49,6 +51,9 @@ vec3 ray_radiance(vec3 origin, vec3 dir) {
     }
     return view_ray(origin, dir, t_hit, hit_index >= 0 && !emitter ? normal : vec3(0.0f), radiance);
 }
+
+// Radiance arriving at the camera along the ray origin + t dir.
+vec3 ray_radiance(vec3 origin, vec3 dir) { return environment_radiance(origin, dir, true); }
 
 // The smallest normal float32 (FLT_MIN): below it a float is subnormal (denormal).
 CONST float RADIANCE_MIN_NORMAL = 1.17549435e-38f;

@@ -362,39 +362,16 @@ ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera&
     return field;
 }
 
-ParticleTiles bin_particles(const std::vector<Particle>& particles, const ParticleCamera& camera, int tile_size) {
-    ParticleTiles t;
-    t.tiles_x = (camera.width + tile_size - 1) / tile_size;
-    t.tiles_y = (camera.height + tile_size - 1) / tile_size;
-    const size_t tiles = size_t(t.tiles_x) * t.tiles_y;
-    std::vector<glm::ivec4> rects(particles.size());
-    std::vector<size_t> counts(tiles + 1, 0);
+ScreenTiles bin_particles(const std::vector<Particle>& particles, const ParticleCamera& camera, int tile_size) {
+    std::vector<glm::ivec4> rects(particles.size(), glm::ivec4(0, -1, 0, -1));
     for (size_t i = 0; i < particles.size(); ++i) {
         int x0 = 0, x1 = -1, y0 = 0, y1 = -1;
-        if (screen_rectangle(particles[i], camera, x0, x1, y0, y1))
-            rects[i] = glm::ivec4(x0 / tile_size, x1 / tile_size, y0 / tile_size, y1 / tile_size);
-        else
-            rects[i] = glm::ivec4(0, -1, 0, -1);
-        for (int y = rects[i].z; y <= rects[i].w; ++y)
-            for (int x = rects[i].x; x <= rects[i].y; ++x) ++counts[size_t(y) * t.tiles_x + x + 1];
+        if (screen_rectangle(particles[i], camera, x0, x1, y0, y1)) rects[i] = glm::ivec4(x0, x1, y0, y1);
     }
-    t.offsets.assign(tiles + 1, 0);
-    size_t total = 0;
-    for (size_t k = 0; k < tiles; ++k) {
-        total += counts[k + 1];
-        if (total > PARTICLE_MAX_TILE_ENTRIES)
-            throw std::runtime_error(
-                "particle_clouds: the particles in view cover more than 2^24 screen-tile entries (the tile lists' "
-                "memory bound); use fewer or larger particles (cell_size, ring_cells, rings) or a smaller film");
-        t.offsets[k + 1] = int(total);
-    }
-    t.entries.assign(total, 0);
-    std::vector<int> fill(t.offsets.begin(), t.offsets.end() - 1);
-    for (size_t i = 0; i < particles.size(); ++i)
-        for (int y = rects[i].z; y <= rects[i].w; ++y)
-            for (int x = rects[i].x; x <= rects[i].y; ++x)
-                t.entries[size_t(fill[size_t(y) * t.tiles_x + x]++)] = int(i);
-    return t;
+    return bin_screen_rectangles(
+        rects, camera.width, camera.height, tile_size, PARTICLE_MAX_TILE_ENTRIES,
+        "particle_clouds: the particles in view cover more than 2^24 screen-tile entries (the tile lists' "
+        "memory bound); use fewer or larger particles (cell_size, ring_cells, rings) or a smaller film");
 }
 
 }  // namespace airlight

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "airlight/scene.hpp"
+#include "screen_tiles.hpp"
 #include "shader_cpp.hpp"
 
 namespace airlight {
@@ -73,12 +74,7 @@ ParticleField particle_field(const ParticleClouds& clouds, const ParticleCamera&
 // of particle indices (into the sorted array, ascending: nearest first) in
 // entries[offsets[k] .. offsets[k + 1]). A particle is listed in every tile
 // its conservative screen rectangle overlaps.
-struct ParticleTiles {
-    int tiles_x = 0, tiles_y = 0;
-    std::vector<int> offsets;
-    std::vector<int> entries;
-};
-ParticleTiles bin_particles(const std::vector<Particle>& particles, const ParticleCamera& camera, int tile_size);
+ScreenTiles bin_particles(const std::vector<Particle>& particles, const ParticleCamera& camera, int tile_size);
 
 struct FrameData;
 // The camera of a frame's shading pass (frame_data's camera and film).

@@ -73,20 +73,6 @@ std::shared_ptr<const Table2D> light_table(float g, ParticleTableQuality quality
                      [&] { return timed_build("particle_light", [&] { return build_light_table(g, quality); }); });
 }
 
-// A per-frame table of `texels` floats in rows of PARTICLE_ROW_TEXELS texels.
-std::shared_ptr<const Table2D> row_table(const char* name, int channels, std::vector<float> texels) {
-    auto t = std::make_shared<Table2D>();
-    t->name = name;
-    t->channels = channels;
-    const size_t n = texels.size() / size_t(channels);
-    t->width = shader::PARTICLE_ROW_TEXELS;
-    t->height = int(std::max<size_t>(1, (n + t->width - 1) / t->width));
-    texels.resize(size_t(t->width) * t->height * channels, 0.0f);
-    t->texels = std::move(texels);
-    t->serial = next_table_serial();
-    return t;
-}
-
 }  // namespace
 
 ParticleCamera particle_camera(const FrameData& data) {
@@ -111,19 +97,13 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
     const int tile_size = scene.quality.particle_compositing == ParticleCompositing::tiles
                               ? shader::PARTICLE_TILE_SIZE
                               : std::max(cam.width, cam.height);
-    const ParticleTiles tiles = bin_particles(field.particles, cam, tile_size);
+    const ScreenTiles tiles = bin_particles(field.particles, cam, tile_size);
     std::vector<float> particles;
     particles.reserve(field.particles.size() * 8);
     for (const Particle& p : field.particles)
         for (float v :
              {p.center.x, p.center.y, p.center.z, p.radius, p.tau, p.sun_transmittance, p.sky_visibility, 0.0f})
             particles.push_back(v);
-    // The tile table: the tiles' offsets (one more than the tiles), then the entries; indices are
-    // exact in float32 below 2^24 (PARTICLE_MAX_TILE_ENTRIES).
-    std::vector<float> lists;
-    lists.reserve(tiles.offsets.size() + tiles.entries.size());
-    for (int v : tiles.offsets) lists.push_back(float(v));
-    for (int v : tiles.entries) lists.push_back(float(v));
     const ParticleTableShape shape = particle_table_shape(scene.quality.particle_table);
     shader::ParticleCloudsGpu& g = data.frame.particle_clouds;
     g.table_shape = glm::ivec4(shape.entry, shape.view_zenith, shape.view_azimuth, shape.taus);
@@ -140,8 +120,8 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
         g.shadow_size = glm::ivec4(m.size, 0, 0, 0);
     }
     if (particles.empty()) particles.assign(8, 0.0f);
-    data.use_table(shader::TABLE_PARTICLES, row_table("particles", 4, std::move(particles)));
-    data.use_table(shader::TABLE_PARTICLE_TILES, row_table("particle_tiles", 1, std::move(lists)));
+    data.use_table(shader::TABLE_PARTICLES, row_table("particles", 4, shader::PARTICLE_ROW_TEXELS, std::move(particles)));
+    data.use_table(shader::TABLE_PARTICLE_TILES, row_table("particle_tiles", 1, shader::PARTICLE_ROW_TEXELS, screen_tile_texels(tiles)));
     data.use_table(shader::TABLE_PARTICLE_LIGHT, light_table(c.g, scene.quality.particle_table));
 }
 

@@ -24,6 +24,9 @@ struct Camera {
     glm::vec3 look_at{0.0f, 1.7f, -10.0f};
     glm::vec3 up{0.0f, 1.0f, 0.0f};
     float fov_y_degrees = 60.0f;
+    // The shutter's open time (s) ending at the scene's time: moving falling
+    // rain drops leave streaks over it (effects/falling_rain/physics.md section 4).
+    float exposure_time = 1.0f / 60.0f;
 };
 
 enum class PhaseType { isotropic, hg, rayleigh, hg2 };

@@ -1,0 +1,108 @@
+// The falling rain's part of the frame (physics.md sections 3-5): the drops
+// in view for the frame's exposure, their streaks binned into screen tiles,
+// the drop's optics table and the grid pass that lights each drop; nothing
+// for a scene without falling rain.
+#include <algorithm>
+#include <cmath>
+#include <glm/glm.hpp>
+
+#include "drop_optics.hpp"
+#include "drops.hpp"
+#include "frame_data.hpp"
+#include "numerics.hpp"
+#include "rainbow.hpp"
+#include "screen_tiles.hpp"
+
+namespace airlight {
+
+namespace {
+
+// The optics table (eq. 4.3): the phase function f(theta) over
+// DROP_OPTICS_BINS bins of theta; RGB for water at 610, 550 and 465 nm.
+Table2D build_drop_optics() {
+    constexpr int bins = shader::DROP_OPTICS_BINS;
+    Table2D t;
+    t.width = bins;
+    t.height = 1;
+    t.channels = 4;
+    t.texels.assign(size_t(bins) * 4, 0.0f);
+    const double wavelengths[3] = {610.0, 550.0, 465.0};
+    for (int c = 0; c < 3; ++c) {
+        const double n = water_refractive_index(wavelengths[c]);
+        std::vector<double> f(bins, 0.0);
+        for (int p = 0; p < DROP_ORDERS; ++p) {
+            const std::vector<double> fp = drop_phase_order(n, p, bins, 1 << 20);
+            for (int b = 0; b < bins; ++b) f[size_t(b)] += fp[size_t(b)];
+        }
+        for (int b = 0; b < bins; ++b) t.texels[size_t(b) * 4 + c] = float(f[size_t(b)]);
+    }
+    return t;
+}
+
+}  // namespace
+
+void pack_falling_rain_frame(const Scene& scene, FrameData& data) {
+    const FallingRain& rain = scene.falling_rain;
+    if (!rain.present || !(rain.rate > 0.0f)) return;
+    const glm::dvec3 camera(scene.camera.position);
+    const glm::dvec3 right(glm::vec3(data.frame.camera_right)), up(glm::vec3(data.frame.camera_up)),
+        forward(glm::vec3(data.frame.camera_forward));
+    const int width = data.frame.film_width, height = data.frame.film_height;
+    const double exposure = scene.camera.exposure_time;
+    // A streak's pixel rectangle (section 5): its ends cut at RAIN_NEAR, projected, grown by the
+    // drop's half width and a pixel; x1 < x0 when it misses the film.
+    const auto rectangle = [&](const RainDrop& d) {
+        glm::dvec3 a = d.position - 0.5 * exposure * d.velocity - camera;
+        glm::dvec3 b = d.position + 0.5 * exposure * d.velocity - camera;
+        const double near = double(shader::RAIN_NEAR);
+        const double za = glm::dot(a, forward), zb = glm::dot(b, forward);
+        if (za < near && zb < near) return glm::ivec4(0, -1, 0, -1);
+        if (za < near) a += (b - a) * ((near - za) / (zb - za));
+        if (zb < near) b += (a - b) * ((near - zb) / (za - zb));
+        double x_lo = 1e300, x_hi = -1e300, y_lo = 1e300, y_hi = -1e300, z_min = 1e300;
+        for (const glm::dvec3& q : {a, b}) {
+            const double z = glm::dot(q, forward);
+            const double x = 0.5 * (glm::dot(q, right) / (glm::dot(right, right) * z) + 1.0) * width;
+            const double y = 0.5 * (1.0 - glm::dot(q, up) / (glm::dot(up, up) * z)) * height;
+            x_lo = std::min(x_lo, x), x_hi = std::max(x_hi, x), y_lo = std::min(y_lo, y), y_hi = std::max(y_hi, y);
+            z_min = std::min(z_min, z);
+        }
+        const double grow = 0.5e-3 * d.diameter / (z_min * 2.0 * glm::length(up) / height) + 1.0;
+        x_lo -= grow, x_hi += grow, y_lo -= grow, y_hi += grow;
+        if (x_hi < 0.0 || y_hi < 0.0 || x_lo >= width || y_lo >= height) return glm::ivec4(0, -1, 0, -1);
+        return glm::ivec4(int(std::max(x_lo, 0.0)), int(std::min(x_hi, width - 1.0)), int(std::max(y_lo, 0.0)),
+                          int(std::min(y_hi, height - 1.0)));
+    };
+    const std::vector<RainDrop> drops = rain_drops(rain, camera, exposure, [&](const RainDrop& d) {
+        const glm::ivec4 r = rectangle(d);
+        return r.y >= r.x && d.weight > 0.0;
+    });
+    if (drops.empty()) return;
+    std::vector<glm::ivec4> rects;
+    rects.reserve(drops.size());
+    std::vector<float> texels;
+    texels.reserve(drops.size() * 8);
+    for (const RainDrop& d : drops) {
+        rects.push_back(rectangle(d));
+        const glm::dvec3 a = d.position - 0.5 * exposure * d.velocity - camera;
+        const glm::dvec3 b = d.position + 0.5 * exposure * d.velocity - camera;
+        for (double v : {a.x, a.y, a.z, 1e-3 * d.diameter, b.x, b.y, b.z, d.weight}) texels.push_back(float(v));
+    }
+    const ScreenTiles tiles = bin_screen_rectangles(
+        rects, width, height, shader::RAIN_TILE_SIZE, size_t(1) << 24,
+        "falling_rain: the streaks in view cover more than 2^24 screen-tile entries (the tile lists' memory bound); "
+        "lower falling_rain.radius or camera.exposure_time, or use a smaller film");
+    const int count = int(drops.size());
+    data.features.falling_rain = true;
+    data.frame.falling_rain.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, count, shader::RAIN_TILE_SIZE);
+    data.use_table(shader::TABLE_RAIN_DROPS, row_table("rain_drops", 4, shader::RAIN_ROW_TEXELS, std::move(texels)));
+    data.use_table(shader::TABLE_RAIN_TILES,
+                   row_table("rain_tiles", 1, shader::RAIN_ROW_TEXELS, screen_tile_texels(tiles)));
+    data.tables[size_t(shader::TABLE_DROP_OPTICS)] = &table_built_once("drop_optics", build_drop_optics);
+    data.grid_passes.push_back({shader::TABLE_RAIN_ENVIRONMENT, shader::RAIN_ENV_WIDTH, shader::RAIN_ENV_HEIGHT, 4});
+    data.grid_passes.push_back({shader::TABLE_RAIN_SURROUND, shader::RAIN_ENV_WIDTH, shader::RAIN_ENV_HEIGHT, 4});
+    data.grid_passes.push_back({shader::TABLE_RAIN_LIGHT, std::min(count, shader::RAIN_ROW_TEXELS),
+                                (count + shader::RAIN_ROW_TEXELS - 1) / shader::RAIN_ROW_TEXELS, 4});
+}
+
+}  // namespace airlight
