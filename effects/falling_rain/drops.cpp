@@ -98,6 +98,20 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
     const double lam = marshall_palmer_slope(rain.rate);
     const double t_mid = rain.time - 0.5 * exposure;
     const glm::dvec3 wind(rain.wind);
+    // The drops within their draw distances, expected (eq. 1.3 per class): beyond FALLING_RAIN_MAX_SPHERE
+    // the frame's drops are not even counted (the bound on the time spent drawing them).
+    double expected = 0.0;
+    for (int k = 0; k < RAIN_DROP_CLASSES; ++k) {
+        const double reach = rain_draw_distance(rain, class_edge(k + 1));
+        expected += rain_number_density(rain.rate, class_edge(k), class_edge(k + 1)) * 4.0 / 3.0 * numerics::kPi *
+                    reach * reach * reach;
+    }
+    if (expected > double(FALLING_RAIN_MAX_SPHERE))
+        throw std::runtime_error("falling_rain: about " + std::to_string(std::llround(expected)) +
+                                 " drops within their draw distances, more than " +
+                                 std::to_string(FALLING_RAIN_MAX_SPHERE) +
+                                 " (the bound on the time spent drawing them); lower falling_rain.radius or "
+                                 "falling_rain.full_diameter");
     for (int k = 0; k < RAIN_DROP_CLASSES; ++k) {
         const double d_lo = class_edge(k), d_hi = class_edge(k + 1);
         const double v_lo = terminal_speed(d_lo), v_hi = terminal_speed(d_hi);

@@ -23,6 +23,8 @@ constexpr int RAIN_DROP_CLASSES = 24;
 constexpr double FALLING_RAIN_FADE = 0.25;
 // At most this many drops a frame (the tables' memory bound, section 5).
 constexpr std::size_t FALLING_RAIN_MAX_DROPS = std::size_t(1) << 21;
+// At most this many drops, expected, within their draw distances (the time bound, section 3).
+constexpr std::size_t FALLING_RAIN_MAX_SPHERE = std::size_t(1) << 24;
 
 // Marshall-Palmer N(D) = N0 exp(-Lambda D) (eq. 1.1): N0 is MARSHALL_PALMER_N0
 // (effects/daytime/sky.hpp), Lambda marshall_palmer_slope (effects/rainbow/rainbow.hpp).

@@ -45,21 +45,38 @@ void rain_clip(float a, float b, INOUT(float) lo, INOUT(float) hi) {
     else if (a < 0.0f) hi = lo - 1.0f;
 }
 
-// The part [lo, hi] of the exposure (tau in [0, 1] along the streak from
-// start s to end e, relative to the camera) during which the drop's centre
-// projects into pixel (x, row) grown by `grow` pixels on each side (eq. 5.1):
-// each film edge is a plane through the camera, linear in tau. Empty: hi <= lo.
-vec2 rain_pixel_interval(vec3 s, vec3 e, int x, int row, float grow) {
+// The film's pixel coordinate of the streak point s + tau d (relative to the
+// camera) along film axis `axis` (r or u, with sign +1 for x and -1 for
+// rows), and the tau at which it equals pixel coordinate c: each is a plane
+// through the camera, linear in tau (eq. 5.1).
+float rain_film_coordinate(float a, float b, float z0, float z1, float pixels, float sign_, float tau) {
+    return 0.5f * pixels * (1.0f + sign_ * (a + b * tau) / (z0 + z1 * tau));
+}
+float rain_film_crossing(float a, float b, float z0, float z1, float pixels, float sign_, float c) {
+    float k = sign_ * (2.0f * c / pixels - 1.0f);
+    float den = b - k * z1;
+    return abs(den) > 1e-30f ? (k * z0 - a) / den : -1.0f;
+}
+
+// The share of a box footprint of side w pixels centred at c that lies over
+// the pixel [p, p + 1] along one axis (eq. 5.1): summed over the pixels it is 1.
+float rain_footprint_share(float c, float p, float w) {
+    return max(min(c + 0.5f * w, p + 1.0f) - max(c - 0.5f * w, p), 0.0f) / w;
+}
+
+// The drop's solid angle times the share of its footprint over pixel (x, row),
+// integrated over the exposure (tau in [0, 1]) of the streak from s to e
+// relative to the camera (eq. 5.1): the footprint is a square of side w
+// pixels (the drop's width at the streak's middle); the integrand is a
+// product of two ramps, so Simpson's rule between its breakpoints (where a
+// footprint edge crosses a pixel edge) is exact up to the perspective's
+// curvature. Returns (integral, tau at the middle of the time in the pixel).
+vec2 rain_pixel_coverage(vec3 s, vec3 e, int x, int row, float w, float drop_radius) {
     vec3 r = vec3(frame.camera_right);
     vec3 u = vec3(frame.camera_up);
     vec3 f = vec3(frame.camera_forward);
     float width = float(frame.film_width);
     float height = float(frame.film_height);
-    // Film coordinates sx = (q . r) / (|r|^2 z), sy = (q . u) / (|u|^2 z), z = q . f.
-    float sx_lo = 2.0f * (float(x) - grow) / width - 1.0f;
-    float sx_hi = 2.0f * (float(x) + 1.0f + grow) / width - 1.0f;
-    float sy_hi = 1.0f - 2.0f * (float(row) - grow) / height;
-    float sy_lo = 1.0f - 2.0f * (float(row) + 1.0f + grow) / height;
     vec3 d = e - s;
     float xs = dot(s, r) / dot(r, r), xd = dot(d, r) / dot(r, r);
     float ys = dot(s, u) / dot(u, u), yd = dot(d, u) / dot(u, u);
@@ -67,9 +84,51 @@ vec2 rain_pixel_interval(vec3 s, vec3 e, int x, int row, float grow) {
     float lo = 0.0f;
     float hi = 1.0f;
     rain_clip(zs - RAIN_NEAR, zd, lo, hi);
-    rain_clip(xs - sx_lo * zs, xd - sx_lo * zd, lo, hi);
-    rain_clip(sx_hi * zs - xs, sx_hi * zd - xd, lo, hi);
-    rain_clip(ys - sy_lo * zs, yd - sy_lo * zd, lo, hi);
-    rain_clip(sy_hi * zs - ys, sy_hi * zd - yd, lo, hi);
-    return vec2(lo, hi);
+    // The times the footprint overlaps the pixel at all: the pixel grown by w / 2.
+    float px = float(x);
+    float py = float(row);
+    float h = 0.5f * w;
+    float x_lo = 2.0f * (px - h) / width - 1.0f, x_hi = 2.0f * (px + 1.0f + h) / width - 1.0f;
+    float y_hi = 1.0f - 2.0f * (py - h) / height, y_lo = 1.0f - 2.0f * (py + 1.0f + h) / height;
+    rain_clip(xs - x_lo * zs, xd - x_lo * zd, lo, hi);
+    rain_clip(x_hi * zs - xs, x_hi * zd - xd, lo, hi);
+    rain_clip(ys - y_lo * zs, yd - y_lo * zd, lo, hi);
+    rain_clip(y_hi * zs - ys, y_hi * zd - yd, lo, hi);
+    if (!(hi > lo)) return vec2(0.0f, -1.0f);
+    // Breakpoints: a footprint edge on a pixel edge, in x (sign +1) and in rows (sign -1).
+    float cuts[10];
+    int n = 0;
+    cuts[n++] = lo;
+    for (int k = 0; k < 4; ++k) {
+        float c = (k < 2 ? px : px + 1.0f) + (k % 2 == 0 ? -h : h);
+        float tx = rain_film_crossing(xs, xd, zs, zd, width, 1.0f, c);
+        if (tx > lo && tx < hi) cuts[n++] = tx;
+        float cy = (k < 2 ? py : py + 1.0f) + (k % 2 == 0 ? -h : h);
+        float ty = rain_film_crossing(ys, yd, zs, zd, height, -1.0f, cy);
+        if (ty > lo && ty < hi) cuts[n++] = ty;
+    }
+    cuts[n++] = hi;
+    for (int i = 1; i < n; ++i)  // insertion sort
+        for (int j = i; j > 0 && cuts[j - 1] > cuts[j]; --j) {
+            float t = cuts[j];
+            cuts[j] = cuts[j - 1];
+            cuts[j - 1] = t;
+        }
+    float total = 0.0f;
+    for (int i = 0; i + 1 < n; ++i) {
+        float a = cuts[i];
+        float b = cuts[i + 1];
+        if (!(b > a)) continue;
+        float g[3];
+        for (int k = 0; k < 3; ++k) {
+            float t = a + 0.5f * float(k) * (b - a);
+            vec3 q = s + t * d;
+            float cx = rain_film_coordinate(xs, xd, zs, zd, width, 1.0f, t);
+            float cy = rain_film_coordinate(ys, yd, zs, zd, height, -1.0f, t);
+            g[k] = rain_footprint_share(cx, px, w) * rain_footprint_share(cy, py, w) * PI * drop_radius *
+                   drop_radius / dot(q, q);
+        }
+        total += (b - a) / 6.0f * (g[0] + 4.0f * g[1] + g[2]);
+    }
+    return vec2(total, 0.5f * (lo + hi));
 }

@@ -19,7 +19,7 @@ void parse_falling_rain_keys(const SceneObject& top, Scene& s) {
     FallingRain& r = s.falling_rain;
     r.present = true;
     if (auto x = o.opt("rate")) {
-        r.rate = read_in_range(*x, 0.0, 500.0, " mm/h");
+        r.rate = read_in_range(*x, 0.0, 2000.0, " mm/h");  // the 1-minute world record is ~1900 mm/h
     } else if (s.atmosphere.rain.present) {
         r.rate = s.atmosphere.rain.rate * s.atmosphere.rain.density_scale;
     } else {

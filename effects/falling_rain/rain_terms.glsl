@@ -103,18 +103,15 @@ vec3 falling_rain_pixel_cores(int x, int row, vec3 radiance) {
         vec4 stop = rain_texel4(TABLE_RAIN_DROPS, 2 * k + 1);
         vec3 s = vec3(start);
         vec3 e = vec3(stop);
-        vec3 middle = 0.5f * (s + e);
-        float z_mid = max(dot(middle, f), RAIN_NEAR);
-        // A drop wider than a pixel is spread over its width (eq. 5.1): the pixel grown by half of it.
-        float grow = 0.5f * start.w / (z_mid * pixel_side);
-        vec2 span = rain_pixel_interval(s, e, x, row, grow);
-        if (!(span.y > span.x)) continue;
-        vec3 q = s + (0.5f * (span.x + span.y)) * (e - s);
+        // The drop's width in pixels at the streak's middle (eq. 5.1), its footprint no narrower than 1e-3 px.
+        float z_mid = max(dot(0.5f * (s + e), f), RAIN_NEAR);
+        float w = max(start.w / (z_mid * pixel_side), 1e-3f);
+        vec2 coverage = rain_pixel_coverage(s, e, x, row, w, 0.5f * start.w);
+        if (!(coverage.x > 0.0f)) continue;
+        vec3 q = s + coverage.y * (e - s);
         float d = length(q);
         if (d >= t_hit) continue;
-        float drop_solid_angle = PI * 0.25f * start.w * start.w / (d * d);
-        float spread = 1.0f / ((1.0f + 2.0f * grow) * (1.0f + 2.0f * grow));
-        float alpha = min(stop.w * (span.y - span.x) * spread * drop_solid_angle / pixel_solid_angle, 1.0f);
+        float alpha = min(stop.w * coverage.x / pixel_solid_angle, 1.0f);
         vec3 seen = vec3(rain_texel4(TABLE_RAIN_LIGHT, k)) * transmittance(d) * atmosphere_transmittance(origin, q / d, d);
         outputs_cover(1.0f - alpha);
         layer_add(LAYER_FALLING_RAIN, seen * alpha);
