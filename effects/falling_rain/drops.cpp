@@ -110,16 +110,15 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
         throw std::runtime_error("falling_rain: about " + std::to_string(std::llround(expected)) +
                                  " drops within their draw distances, more than " +
                                  std::to_string(FALLING_RAIN_MAX_SPHERE) +
-                                 " (the bound on the time spent drawing them); lower falling_rain.radius or "
+                                 " (the bound on the time spent drawing them); lower falling_rain.radius or raise "
                                  "falling_rain.full_diameter");
     for (int k = 0; k < RAIN_DROP_CLASSES; ++k) {
         const double d_lo = class_edge(k), d_hi = class_edge(k + 1);
         const double v_lo = terminal_speed(d_lo), v_hi = terminal_speed(d_hi);
         const double reach = rain_draw_distance(rain, d_hi);
         // Drops crossing the plane y = 0 per m^2 per s (eq. 3.1).
-        const double flux = integrate(d_lo, d_hi, [&](double d) {
-            return MARSHALL_PALMER_N0 * std::exp(-lam * d) * terminal_speed(d);
-        });
+        const double flux = integrate(
+            d_lo, d_hi, [&](double d) { return MARSHALL_PALMER_N0 * std::exp(-lam * d) * terminal_speed(d); });
         if (!(flux > 0.0)) continue;
         // Cells of (xi_x, xi_z, t0) holding 4 drops on average, xi = crossing point - wind t0 (eq. 3.2).
         const double cell = std::max(0.5 * reach, 1e-3);
@@ -153,8 +152,8 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
                         RainDrop drop;
                         drop.diameter = d;
                         drop.velocity = glm::dvec3(wind.x, -terminal_speed(d), wind.z);
-                        drop.position = glm::dvec3(px + wind.x * t_mid, -terminal_speed(d) * (t_mid - t0),
-                                                   pz + wind.z * t_mid);
+                        drop.position =
+                            glm::dvec3(px + wind.x * t_mid, -terminal_speed(d) * (t_mid - t0), pz + wind.z * t_mid);
                         const double dist = glm::length(drop.position - camera);
                         if (dist > rain_draw_distance(rain, d)) continue;
                         drop.weight = rain_draw_weight(rain, d, dist);
@@ -163,7 +162,7 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
                         if (drops.size() >= FALLING_RAIN_MAX_DROPS)
                             throw std::runtime_error(
                                 "falling_rain: more than " + std::to_string(FALLING_RAIN_MAX_DROPS) +
-                                " drops in view (the drop tables' memory bound); lower falling_rain.radius or "
+                                " drops in view (the drop tables' memory bound); lower falling_rain.radius or raise "
                                 "falling_rain.full_diameter");
                         drops.push_back(drop);
                     }

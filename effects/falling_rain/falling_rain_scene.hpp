@@ -15,11 +15,11 @@ namespace airlight {
 // (section 2: the split with the continuous medium).
 struct FallingRain {
     bool present = false;
-    float rate = 0.0f;            // mm/h; 0: the atmosphere's rain rate
-    float radius = 8.0f;          // m: the largest distance at which drops are drawn
-    float full_diameter = 2.0f;   // mm: drops at least this large are drawn out to `radius`
-    glm::vec3 wind{0.0f};         // m/s, horizontal (y = 0)
-    double time = 0.0;            // s: the end of the exposure
+    float rate = 0.0f;           // mm/h (0: no drops); the key's default is the atmosphere's rain rate
+    float radius = 8.0f;         // m: the largest distance at which drops are drawn
+    float full_diameter = 2.0f;  // mm: drops at least this large are drawn out to `radius`
+    glm::vec3 wind{0.0f};        // m/s, horizontal (y = 0)
+    double time = 0.0;           // s: the end of the exposure
     std::uint32_t seed = 1;
 };
 

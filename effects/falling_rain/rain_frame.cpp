@@ -40,21 +40,22 @@ Table2D build_drop_optics() {
 }
 
 // Whether any light can reach a drop (section 5): a lamp, a spot, the sun
-// above the horizon, a sky, a background, a backplate or the medium's
-// constant light. A scene with none sees no drop and pays nothing for them.
+// above the horizon, a sky, a background or the medium's constant light. A
+// scene with none sees no drop and pays nothing for them.
 bool light_can_show_a_drop(const Scene& scene) {
     const auto positive = [](const Rgb& c) { return glm::any(glm::greaterThan(c, Rgb(0.0f))); };
     const bool sun = scene.sun.present && scene.sun.direction.y > 0.0f && positive(scene.sun.irradiance);
     const bool sky = scene.sky.model != SkyModel::none && positive(scene.sky.zenith_radiance);
     return !scene.point_lights.empty() || !scene.spot_lights.empty() || sun || sky || positive(scene.background) ||
-           scene.backplate.rgbd != nullptr || positive(scene.atmospheric_light);
+           positive(scene.atmospheric_light);
 }
 
 }  // namespace
 
 void pack_falling_rain_frame(const Scene& scene, FrameData& data) {
     const FallingRain& rain = scene.falling_rain;
-    if (!rain.present || !(rain.rate > 0.0f) || !light_can_show_a_drop(scene)) return;
+    // Not yet drawn over a photograph (a backplate ends the ray before the pixel_cores hook; section 6).
+    if (!rain.present || !(rain.rate > 0.0f) || !light_can_show_a_drop(scene) || scene.backplate.rgbd) return;
     const glm::dvec3 camera(scene.camera.position);
     const glm::dvec3 right(glm::vec3(data.frame.camera_right)), up(glm::vec3(data.frame.camera_up)),
         forward(glm::vec3(data.frame.camera_forward));

@@ -320,7 +320,7 @@ def test_outputs_lists_and_describes_every_output() -> None:
     assert list(airlight.OUTPUTS)[:5] == ["radiance", "depth", "distance_z", "normal", "transmittance"]
     assert set(airlight.LAYERS) == {
         "surfaces", "lamps", "spots", "rainbow", "atmospheric_light", "sky", "medium_sun", "clouds",
-        "particle_clouds"}
+        "particle_clouds", "falling_rain"}
     assert all(len(text) > 20 for text in airlight.OUTPUTS.values())
 
 

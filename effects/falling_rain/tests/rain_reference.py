@@ -17,12 +17,23 @@ N0 = 8000.0
 D_MIN, D_MAX = 0.1, 6.0  # mm: the cut the renderer documents (physics.md section 1)
 
 # Gunn and Kinzer (1949), terminal speed of water drops in stagnant air at 1013 hPa, 20 C (m/s).
-GUNN_KINZER = {0.5: 2.06, 1.0: 4.03, 1.5: 5.40, 2.0: 6.49, 2.5: 7.41, 3.0: 8.06, 3.5: 8.53,
-               4.0: 8.83, 4.5: 9.00, 5.0: 9.09, 5.5: 9.14}
+GUNN_KINZER = {
+    0.5: 2.06,
+    1.0: 4.03,
+    1.5: 5.40,
+    2.0: 6.49,
+    2.5: 7.41,
+    3.0: 8.06,
+    3.5: 8.53,
+    4.0: 8.83,
+    4.5: 9.00,
+    5.0: 9.09,
+    5.5: 9.14,
+}
 
 
 def slope(rate: float) -> float:
-    return 4.1 * rate ** -0.21
+    return 4.1 * rate**-0.21
 
 
 def number_density(rate: float) -> float:
@@ -34,8 +45,9 @@ def number_density(rate: float) -> float:
 def water_content(rate: float) -> float:
     """Liquid water (g/m^3) in drops with D in [D_MIN, D_MAX]: pi/6 D^3 mm^3 at 1e-3 g/mm^3 each."""
     lam = slope(rate)
-    return integrate.quad(lambda d: N0 * math.exp(-lam * d) * math.pi / 6 * d ** 3 * 1e-3, D_MIN, D_MAX,
-                          epsabs=0, epsrel=1e-12)[0]
+    return integrate.quad(
+        lambda d: N0 * math.exp(-lam * d) * math.pi / 6 * d**3 * 1e-3, D_MIN, D_MAX, epsabs=0, epsrel=1e-12
+    )[0]
 
 
 def diameter_cdf(rate: float, d: np.ndarray) -> np.ndarray:
@@ -46,6 +58,7 @@ def diameter_cdf(rate: float, d: np.ndarray) -> np.ndarray:
 
 
 # --- A water sphere's orders in closed form (Debye series, geometric optics) -------------------------
+
 
 def fresnel(n: float, i: np.ndarray) -> tuple[np.ndarray, np.ndarray]:
     """Reflectances (s, p) at incidence i from air onto water of index n."""
@@ -78,11 +91,13 @@ def order_phase(n: float, p: int, theta: float) -> float:
     g = scattering_angle(n, p, grid) - theta
     total = 0.0
     for k in np.nonzero(np.sign(g[:-1]) * np.sign(g[1:]) < 0)[0]:
-        i = optimize.brentq(lambda x: float(scattering_angle(n, p, np.array(x))) - theta, grid[k], grid[k + 1],
-                            xtol=1e-15)
+        i = optimize.brentq(
+            lambda x: float(scattering_angle(n, p, np.array(x))) - theta, grid[k], grid[k + 1], xtol=1e-15
+        )
         h = 1e-7
-        dtheta = (float(scattering_angle(n, p, np.array(i + h))) - float(scattering_angle(n, p, np.array(i - h)))) / (
-            2 * h)
+        dtheta = (
+            float(scattering_angle(n, p, np.array(i + h))) - float(scattering_angle(n, p, np.array(i - h)))
+        ) / (2 * h)
         b, db = math.sin(i), math.cos(i)
         total += float(order_energy(n, p, np.array(i))) * b * db / (math.pi * math.sin(theta) * abs(dtheta))
     return total
@@ -90,8 +105,14 @@ def order_phase(n: float, p: int, theta: float) -> float:
 
 def order_power(n: float, p: int) -> float:
     """The share of the light on the cross-section leaving by order p: eps_p integrated over b^2 = sin^2 i."""
-    return integrate.quad(lambda i: float(order_energy(n, p, np.array(i))) * math.sin(2 * i), 0, math.pi / 2,
-                          epsabs=0, epsrel=1e-12, limit=200)[0]
+    return integrate.quad(
+        lambda i: float(order_energy(n, p, np.array(i))) * math.sin(2 * i),
+        0,
+        math.pi / 2,
+        epsabs=0,
+        epsrel=1e-12,
+        limit=200,
+    )[0]
 
 
 def drop_phase(n: float, theta: float, orders: int) -> float:
@@ -100,6 +121,7 @@ def drop_phase(n: float, theta: float, orders: int) -> float:
 
 
 # --- A streak on the film ---------------------------------------------------------------------------
+
 
 def camera_frame(scene: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
     """Camera position and its right, up and forward axes scaled as the film's (tan of half the field)."""
@@ -136,12 +158,18 @@ def pixel_solid_angles(scene: dict[str, Any]) -> np.ndarray:
     wx = np.tile(0.5 * weights, w) * sx
     wy = np.tile(0.5 * weights, h) * sy
     X, Y = np.meshgrid(xs, ys)
-    integrand = (1 + X ** 2 + Y ** 2) ** -1.5 * np.outer(wy, wx)
+    integrand = (1 + X**2 + Y**2) ** -1.5 * np.outer(wy, wx)
     return integrand.reshape(h, 6, w, 6).sum(axis=(1, 3))
 
 
-def streak_solid_angle_time(scene: dict[str, Any], position: np.ndarray, velocity: np.ndarray, diameter_mm: float,
-                            sigma_t: float = 0.0, samples: int = 4001) -> float:
+def streak_solid_angle_time(
+    scene: dict[str, Any],
+    position: np.ndarray,
+    velocity: np.ndarray,
+    diameter_mm: float,
+    sigma_t: float = 0.0,
+    samples: int = 4001,
+) -> float:
     """The drop's solid angle pi a^2 / d^2, times the medium's transmittance exp(-sigma_t d) to the camera,
     averaged over the exposure (the streak's centre from position - v T / 2 to position + v T / 2)."""
     o = np.array(scene["camera"]["position"], float)
@@ -150,4 +178,4 @@ def streak_solid_angle_time(scene: dict[str, Any], position: np.ndarray, velocit
     q = position[None, :] + tau[:, None] * t * velocity[None, :]
     d = np.linalg.norm(q - o, axis=1)
     a = 0.5e-3 * diameter_mm
-    return float(integrate.simpson(math.pi * a * a / d ** 2 * np.exp(-sigma_t * d), x=tau))
+    return float(integrate.simpson(math.pi * a * a / d**2 * np.exp(-sigma_t * d), x=tau))

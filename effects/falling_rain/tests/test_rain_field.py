@@ -30,7 +30,14 @@ INNER = 0.7
 
 def field(rate: float, radius: float, **keys: Any) -> tuple[dict[str, Any], dict[str, np.ndarray]]:
     scene = copy.deepcopy(SCENE)
-    scene["falling_rain"] = {"rate": rate, "radius": radius, "full_diameter": 0.1, "time": 37.0, "seed": 5, **keys}
+    scene["falling_rain"] = {
+        "rate": rate,
+        "radius": radius,
+        "full_diameter": 0.1,
+        "time": 37.0,
+        "seed": 5,
+        **keys,
+    }
     return scene, airlight._core.rain_drops(scene)
 
 
@@ -61,9 +68,12 @@ def test_number_density_and_water_content_match_the_integrals(rate):
     assert abs(count - expected) < 4.5 * math.sqrt(expected), (count, expected)
     # Water: the sampled sum of pi/6 D^3 against the integral, within 4.5 of its sampling error.
     water = math.pi / 6 * drops["diameter"][keep] ** 3 * 1e-3
-    sigma = math.sqrt(np.sum(water ** 2))  # compound Poisson: variance = sum of squares
-    assert abs(water.sum() - ref.water_content(rate) * volume) < 4.5 * sigma, (water.sum(), ref.water_content(rate)
-                                                                                * volume, sigma)
+    sigma = math.sqrt(np.sum(water**2))  # compound Poisson: variance = sum of squares
+    assert abs(water.sum() - ref.water_content(rate) * volume) < 4.5 * sigma, (
+        water.sum(),
+        ref.water_content(rate) * volume,
+        sigma,
+    )
 
 
 def test_water_content_is_marshall_palmers_classic_value():
@@ -72,13 +82,15 @@ def test_water_content_is_marshall_palmers_classic_value():
     for rate in (1.0, 10.0, 100.0):
         full = math.pi * ref.N0 / ref.slope(rate) ** 4 * 1e-3
         assert 0.95 * full < ref.water_content(rate) <= full
-        assert abs(full / (0.089 * rate ** 0.84) - 1) < 0.1
+        assert abs(full / (0.089 * rate**0.84) - 1) < 0.1
 
 
 def test_fall_speeds_match_the_fit_and_gunn_kinzer():
     scene, drops = field(25.0, 1.0)
     d = drops["diameter"]
-    fit = np.where(d >= 0.25, 9.65 - 10.3 * np.exp(-0.6 * d), (9.65 - 10.3 * math.exp(-0.15)) * (d / 0.25) ** 2)
+    fit = np.where(
+        d >= 0.25, 9.65 - 10.3 * np.exp(-0.6 * d), (9.65 - 10.3 * math.exp(-0.15)) * (d / 0.25) ** 2
+    )
     np.testing.assert_allclose(-drops["velocity"][:, 1], fit, rtol=1e-12)
     for diameter, measured in ref.GUNN_KINZER.items():
         assert abs(airlight._core.rain_terminal_speed(diameter) / measured - 1) < 0.04, diameter
@@ -95,12 +107,16 @@ def test_drops_move_by_their_velocity_times_the_frame_time(wind):
     later = copy.deepcopy(scene)
     later["falling_rain"]["time"] += dt
     b = airlight._core.rain_drops(later)
-    np.testing.assert_array_equal(a["velocity"][:, [0, 2]], np.tile(np.array(wind, float)[[0, 2]], (len(a["id"]), 1)))
+    np.testing.assert_array_equal(
+        a["velocity"][:, [0, 2]], np.tile(np.array(wind, float)[[0, 2]], (len(a["id"]), 1))
+    )
     common, ia, ib = np.intersect1d(a["id"], b["id"], return_indices=True)
     assert common.size > 0.3 * len(a["id"]), (common.size, len(a["id"]))  # 50 m/s carries 2 m a frame
     np.testing.assert_array_equal(a["velocity"][ia], b["velocity"][ib])
     np.testing.assert_array_equal(a["diameter"][ia], b["diameter"][ib])
-    np.testing.assert_allclose(b["position"][ib] - a["position"][ia], a["velocity"][ia] * dt, rtol=0, atol=1e-9)
+    np.testing.assert_allclose(
+        b["position"][ib] - a["position"][ia], a["velocity"][ia] * dt, rtol=0, atol=1e-9
+    )
 
 
 def test_the_field_does_not_depend_on_where_the_camera_is():
@@ -132,16 +148,27 @@ def test_drops_are_drawn_to_a_distance_growing_with_their_size():
     limit = 4.0 * np.minimum(1.0, drops["diameter"] / 2.0)
     assert np.all(dist <= limit)
     x = np.clip((limit - dist) / (0.25 * limit), 0, 1)
-    np.testing.assert_allclose(drops["weight"], x * x * (3 - 2 * x), atol=1e-5)  # the camera is stored in float
+    np.testing.assert_allclose(
+        drops["weight"], x * x * (3 - 2 * x), atol=1e-5
+    )  # the camera is stored in float
 
 
 @pytest.mark.parametrize(
     ("keys", "field_name"),
-    [({"rate": -1}, "falling_rain.rate"), ({"rate": 3000}, "falling_rain.rate"), ({"rate": "x"}, "falling_rain.rate"),
-     ({"rate": 5, "radius": 0}, "falling_rain.radius"), ({"rate": 5, "full_diameter": 9}, "falling_rain.full_diameter"),
-     ({"rate": 5, "wind": [1, 2, 0]}, "falling_rain.wind"), ({"rate": 5, "wind": [200, 0, 0]}, "falling_rain.wind"),
-     ({"rate": 5, "time": 1e9}, "falling_rain.time"), ({"rate": 5, "seed": -1}, "falling_rain.seed"),
-     ({"rate": 5, "speed": 1}, "falling_rain.speed"), ({}, "falling_rain.rate")])
+    [
+        ({"rate": -1}, "falling_rain.rate"),
+        ({"rate": 3000}, "falling_rain.rate"),
+        ({"rate": "x"}, "falling_rain.rate"),
+        ({"rate": 5, "radius": 0}, "falling_rain.radius"),
+        ({"rate": 5, "full_diameter": 9}, "falling_rain.full_diameter"),
+        ({"rate": 5, "wind": [1, 2, 0]}, "falling_rain.wind"),
+        ({"rate": 5, "wind": [200, 0, 0]}, "falling_rain.wind"),
+        ({"rate": 5, "time": 1e9}, "falling_rain.time"),
+        ({"rate": 5, "seed": -1}, "falling_rain.seed"),
+        ({"rate": 5, "speed": 1}, "falling_rain.speed"),
+        ({}, "falling_rain.rate"),
+    ],
+)
 def test_bad_falling_rain_keys_name_the_field(keys, field_name):
     scene = copy.deepcopy(SCENE)
     scene["falling_rain"] = keys
