@@ -4,9 +4,9 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
-#include <stdexcept>
 #include <string>
 
+#include "airlight/scene_io.hpp"
 #include "numerics.hpp"
 #include "rainbow.hpp"
 #include "sky.hpp"
@@ -107,11 +107,12 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
                     reach * reach * reach;
     }
     if (expected > double(FALLING_RAIN_MAX_SPHERE))
-        throw std::runtime_error("falling_rain: about " + std::to_string(std::llround(expected)) +
-                                 " drops within their draw distances, more than " +
-                                 std::to_string(FALLING_RAIN_MAX_SPHERE) +
-                                 " (the bound on the time spent drawing them); lower falling_rain.radius or raise "
-                                 "falling_rain.full_diameter");
+        throw SceneError(SceneError::Kind::value, "falling_rain.radius",
+                         "about " + std::to_string(std::llround(expected)) +
+                             " drops within their draw distances, more than " +
+                             std::to_string(FALLING_RAIN_MAX_SPHERE) +
+                             " (the bound on the time spent drawing them); lower it or raise "
+                             "falling_rain.full_diameter");
     for (int k = 0; k < RAIN_DROP_CLASSES; ++k) {
         const double d_lo = class_edge(k), d_hi = class_edge(k + 1);
         const double v_lo = terminal_speed(d_lo), v_hi = terminal_speed(d_hi);
@@ -160,10 +161,10 @@ std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& came
                         drop.id = mix(h ^ std::uint64_t(m));
                         if (keep && !keep(drop)) continue;
                         if (drops.size() >= FALLING_RAIN_MAX_DROPS)
-                            throw std::runtime_error(
-                                "falling_rain: more than " + std::to_string(FALLING_RAIN_MAX_DROPS) +
-                                " drops in view (the drop tables' memory bound); lower falling_rain.radius or raise "
-                                "falling_rain.full_diameter");
+                            throw SceneError(SceneError::Kind::value, "falling_rain.radius",
+                                             "more than " + std::to_string(FALLING_RAIN_MAX_DROPS) +
+                                                 " drops in view (the drop tables' memory bound); lower it "
+                                                 "or raise falling_rain.full_diameter");
                         drops.push_back(drop);
                     }
                 }

@@ -39,6 +39,7 @@ from ._display import (
     tone_curve,
 )
 from ._glare import GlareLike, glare
+from ._falling_rain import rain_drops
 from ._image_io import load_exr, load_pfm, save_exr, save_pfm, save_png
 from ._lights import headlights
 from ._rainbow import rainbow_phase
@@ -79,6 +80,7 @@ __all__ = [
     "photo",
     "preset",
     "preset_names",
+    "rain_drops",
     "rainbow_phase",
     "render",
     "save_exr",

@@ -7,6 +7,7 @@ get an error naming them."""
 from __future__ import annotations
 
 import copy
+import json
 import math
 from typing import Any
 
@@ -194,5 +195,16 @@ def test_the_rate_defaults_to_the_atmospheres_rain():
 def test_too_many_drops_is_an_error_naming_the_keys():
     scene = copy.deepcopy(SCENE)
     scene["falling_rain"] = {"rate": 100, "radius": 200, "full_diameter": 0.1}
-    with pytest.raises(Exception, match=r"falling_rain\.radius"):
-        airlight._core.rain_drops(scene)
+    with pytest.raises(ValueError, match=r"falling_rain\.radius"):
+        airlight.rain_drops(scene)
+    with pytest.raises(ValueError, match=r"falling_rain\.radius"):
+        airlight.render(scene, "cpu")
+
+
+def test_public_rain_drops_are_the_fields():
+    scene, drops = field(10.0, 1.0)
+    public = airlight.rain_drops(json.dumps(scene))
+    assert set(public) == {"position", "velocity", "diameter", "weight", "id"}
+    np.testing.assert_array_equal(public["id"], drops["id"])
+    assert public["id"].dtype == np.uint64 and public["position"].shape == (len(drops["id"]), 3)
+    assert all(len(v) == 0 for v in airlight.rain_drops(SCENE).values())
