@@ -38,8 +38,8 @@ from ._display import (
     to_srgb8,
     tone_curve,
 )
-from ._glare import GlareLike, glare
 from ._falling_rain import rain_drops
+from ._glare import GlareLike, glare
 from ._image_io import load_exr, load_pfm, save_exr, save_pfm, save_png
 from ._lights import headlights
 from ._rainbow import rainbow_phase
