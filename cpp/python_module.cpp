@@ -746,9 +746,12 @@ PYBIND11_MODULE(_core, m) {
         },
         py::arg("scene"));
     m.def("rain_terminal_speed", &airlight::terminal_speed, py::arg("diameter_mm"));
-    m.def("rain_draw_distance", [](py::handle scene_obj, double d) {
-        return airlight::rain_draw_distance(scene_from_python(scene_obj).falling_rain, d);
-    }, py::arg("scene"), py::arg("diameter_mm"));
+    m.def(
+        "rain_draw_distance",
+        [](py::handle scene_obj, double d) {
+            return airlight::rain_draw_distance(scene_from_python(scene_obj).falling_rain, d);
+        },
+        py::arg("scene"), py::arg("diameter_mm"));
     m.def(
         "drop_phase_order",
         [](double n, int p, int bins, int samples) {

@@ -120,8 +120,10 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
         g.shadow_size = glm::ivec4(m.size, 0, 0, 0);
     }
     if (particles.empty()) particles.assign(8, 0.0f);
-    data.use_table(shader::TABLE_PARTICLES, row_table("particles", 4, shader::PARTICLE_ROW_TEXELS, std::move(particles)));
-    data.use_table(shader::TABLE_PARTICLE_TILES, row_table("particle_tiles", 1, shader::PARTICLE_ROW_TEXELS, screen_tile_texels(tiles)));
+    data.use_table(shader::TABLE_PARTICLES,
+                   row_table("particles", 4, shader::PARTICLE_ROW_TEXELS, std::move(particles)));
+    data.use_table(shader::TABLE_PARTICLE_TILES,
+                   row_table("particle_tiles", 1, shader::PARTICLE_ROW_TEXELS, screen_tile_texels(tiles)));
     data.use_table(shader::TABLE_PARTICLE_LIGHT, light_table(c.g, scene.quality.particle_table));
 }
 
