@@ -14,7 +14,7 @@
 #include <cstdlib>
 #include <cstring>
 #include <filesystem>
-#include <glm/vec3.hpp>
+#include <glm/glm.hpp>
 #include <string>
 #include <system_error>
 #include <vector>
@@ -54,7 +54,10 @@ const char* kUsage =
     "  frames DIR/frame_NN_DDDDm.png):\n"
     "                     --sequence approaching-car --out DIR [--frames N] [--from M] [--to M]\n"
     "  the end of a rain (a rainbow appearing and fading; needs atmosphere.rain and a sun):\n"
-    "                     --sequence rain-ends --out DIR [--frames N]\n";
+    "                     --sequence rain-ends --out DIR [--frames N]\n"
+    "  a walk in the falling rain (needs falling_rain; the camera walks 1.4 m/s along its\n"
+    "  view, level, 24 frames a second, the drops falling on; frames DIR/frame_NNN_T.TTTs.png):\n"
+    "                     --sequence rain-walk --out DIR [--frames N]\n";
 
 struct Options {
     std::string scene, out, backend = "auto", sequence;
@@ -208,8 +211,8 @@ Options parse_args(int argc, char** argv) {
             if (o.pupil != "auto") parse_number(arg, value, 1.0, 9.0, "'auto' or a diameter in [1, 9] mm");
         } else if (arg == "--sequence") {
             o.sequence = value;
-            if (o.sequence != "approaching-car" && o.sequence != "rain-ends")
-                fail("--sequence must be approaching-car or rain-ends, got '" + o.sequence + "'");
+            if (o.sequence != "approaching-car" && o.sequence != "rain-ends" && o.sequence != "rain-walk")
+                fail("--sequence must be approaching-car, rain-ends or rain-walk, got '" + o.sequence + "'");
         } else if (arg == "--frames")
             o.frames = parse_int(arg, value, 1, 1000);
         else if (arg == "--from")
@@ -362,6 +365,48 @@ int run_rain_ends(airlight::Scene scene, const Options& o, airlight::Backend bac
     return 0;
 }
 
+// A walk in the falling rain (effects/falling_rain/physics.md section 3): the
+// camera walks at RAIN_WALK_SPEED along its view direction levelled (looking
+// where it looked), RAIN_WALK_FPS frames a second, falling_rain.time moving on
+// by each frame's time, so every drop falls and drifts by its velocity times
+// the frame time; one exposure for all frames (the first's, when automatic).
+constexpr double RAIN_WALK_SPEED = 1.4;  // m/s, a walker's pace
+constexpr double RAIN_WALK_FPS = 24.0;
+
+int run_rain_walk(airlight::Scene scene, const Options& o, airlight::Backend backend) {
+    using namespace airlight;
+    if (!scene.falling_rain.present) fail("--sequence rain-walk: the scene needs falling_rain");
+    glm::dvec3 step(glm::dvec3(scene.camera.look_at) - glm::dvec3(scene.camera.position));
+    step.y = 0.0;
+    step = glm::length(step) > 0.0 ? glm::normalize(step) * (RAIN_WALK_SPEED / RAIN_WALK_FPS) : glm::dvec3(0.0);
+    DisplaySettings settings = display_settings(scene, o);
+    std::error_code error;
+    std::filesystem::create_directories(o.out, error);
+    if (error) fail("--out: cannot create directory '" + o.out + "': " + error.message());
+    Renderer renderer(backend);
+    for (int k = 0; k < o.frames; ++k) {
+        Scene frame = scene;
+        const glm::vec3 shift(step * double(k));
+        frame.camera.position += shift;
+        frame.camera.look_at += shift;
+        frame.falling_rain.time = scene.falling_rain.time + double(k) / RAIN_WALK_FPS;
+        const auto start = std::chrono::steady_clock::now();
+        const Image image = renderer.render(frame, &interrupted);
+        const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+        if (k == 0 && settings.exposure_mode == ExposureMode::automatic) {
+            settings.exposure = resolve_exposure(image, settings);
+            settings.exposure_mode = ExposureMode::manual;
+        }
+        const DisplayImage shown = renderer.display(image, settings, frame.camera.fov_y_degrees);
+        char name[80];
+        std::snprintf(name, sizeof name, "/frame_%03d_%.3fs.png", k, frame.falling_rain.time);
+        const std::string path = o.out + name;
+        write_png(path, shown.width, shown.height, shown.srgb8);
+        print_report(path, image, backend, ms, &shown.report);
+    }
+    return 0;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -418,6 +463,7 @@ int main(int argc, char** argv) {
     try {
         if (o.sequence == "approaching-car") return run_sequence(scene, o, backend);
         if (o.sequence == "rain-ends") return run_rain_ends(scene, o, backend);
+        if (o.sequence == "rain-walk") return run_rain_walk(scene, o, backend);
         if (o.window) {
 #ifdef AIRLIGHT_HAVE_GLFW
             return run_window(scene, backend, display_settings(scene, o), o.out);

@@ -1,6 +1,8 @@
 // airlight-demo --window: an interactive view (needs GLFW and a display).
 // W/S forward/back, A/D left/right, Q/E down/up, arrow keys turn, +/-
 // exposure, Esc quits (cpp/window_controls.hpp; the window's title lists them).
+// R/F rain rate, Z/X wind, L/K lamps, T/G the sun's elevation; the falling
+// rain's time runs with the clock.
 // Keys come from GLFW's key callback with their times, so a tap shorter than
 // a frame still counts. Each frame is rendered by a Renderer (GL or CPU
 // backend), passed through the display stage (the scene's display settings:
@@ -9,6 +11,7 @@
 #include "airlight/display.hpp"
 #include "airlight/image_io.hpp"
 #include "airlight/renderer.hpp"
+#include "airlight/scene_io.hpp"
 #include "window_controls.hpp"
 
 #define GLFW_INCLUDE_NONE
@@ -16,6 +19,7 @@
 #define GL_GLEXT_PROTOTYPES 1
 #include <GL/glcorearb.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -85,6 +89,22 @@ WindowAction action_of_key(int key) {
         case GLFW_KEY_MINUS:
         case GLFW_KEY_KP_SUBTRACT:
             return WindowAction::darker;
+        case GLFW_KEY_R:
+            return WindowAction::rain_more;
+        case GLFW_KEY_F:
+            return WindowAction::rain_less;
+        case GLFW_KEY_Z:
+            return WindowAction::wind_west;
+        case GLFW_KEY_X:
+            return WindowAction::wind_east;
+        case GLFW_KEY_L:
+            return WindowAction::lamps_up;
+        case GLFW_KEY_K:
+            return WindowAction::lamps_down;
+        case GLFW_KEY_T:
+            return WindowAction::sun_up;
+        case GLFW_KEY_G:
+            return WindowAction::sun_down;
         case GLFW_KEY_ESCAPE:
             return WindowAction::quit;
         default:
@@ -98,6 +118,33 @@ void on_key(GLFWwindow* window, int key, int /*scancode*/, int action, int /*mod
     if (keys == nullptr || a == WindowAction::count) return;
     if (action == GLFW_PRESS) keys->press(a, glfwGetTime());
     if (action == GLFW_RELEASE) keys->release(a, glfwGetTime());
+}
+
+// The scene under the window's weather (window_controls.hpp), `elapsed`
+// seconds after the window opened: the falling rain's time runs with the clock
+// (the drops fall live), its rate and wind and the lamps scaled within the
+// scene format's bounds, the sun raised or lowered at its azimuth.
+Scene with_weather(const Scene& base, const WindowWeather& w, double elapsed) {
+    Scene s = base;
+    if (s.falling_rain.present) {
+        s.falling_rain.time = base.falling_rain.time + elapsed;
+        s.falling_rain.rate = float(std::min(double(base.falling_rain.rate) * w.rain_factor, 2000.0));
+        const double east = std::clamp(double(base.falling_rain.wind.x) + w.wind_east, -100.0, 100.0);
+        const double north = double(base.falling_rain.wind.z);
+        const double scale = std::min(1.0, 100.0 / std::max(std::hypot(east, north), 1e-30));
+        s.falling_rain.wind = glm::vec3(float(east * scale), 0.0f, float(north * scale));
+    }
+    const float lamps = float(std::min(w.lamp_factor, 1e6));
+    for (auto& l : s.point_lights) l.intensity = glm::min(l.intensity * lamps, glm::vec3(1e30f));
+    for (auto& l : s.spot_lights) l.intensity = glm::min(l.intensity * lamps, glm::vec3(1e30f));
+    if (s.sun.present && w.sun_elevation != 0.0) {
+        const glm::dvec3 d(base.sun.direction);
+        const double elevation = std::clamp(std::asin(std::clamp(d.y, -1.0, 1.0)) + w.sun_elevation, -0.3, 1.55);
+        const double azimuth = std::atan2(d.x, -d.z);
+        s.sun.direction = glm::vec3(float(std::sin(azimuth) * std::cos(elevation)), float(std::sin(elevation)),
+                                    float(-std::cos(azimuth) * std::cos(elevation)));
+    }
+    return s;
 }
 
 }  // namespace
@@ -132,6 +179,9 @@ int run_window(Scene scene, Backend backend, DisplaySettings display, const std:
     view.yaw = std::atan2(forward.x, -forward.z);
     view.pitch = std::asin(glm::clamp(forward.y, -1.0f, 1.0f));
     view.exposure = display.exposure;
+    WindowWeather weather;
+    const Scene base = scene;
+    const double opened = glfwGetTime();
     int tex_w = 0, tex_h = 0;
     Image image;
     DisplayImage shown;
@@ -143,6 +193,14 @@ int run_window(Scene scene, Backend backend, DisplaySettings display, const std:
             display.exposure_mode = ExposureMode::manual;
             display.exposure = view.exposure;
         }
+        if (apply_weather_keys(held, weather)) {
+            const Scene now = with_weather(base, weather, 0.0);
+            std::printf("airlight-demo: rain %.3g mm/h, wind %.3g m/s east, lamps x%.3g, sun %.1f deg\n",
+                        double(now.falling_rain.rate), double(now.falling_rain.wind.x), weather.lamp_factor,
+                        std::asin(double(now.sun.direction.y)) * 57.29577951308232);
+            std::fflush(stdout);
+        }
+        scene = with_weather(base, weather, glfwGetTime() - opened);
         scene.camera.position = view.position;
         scene.camera.look_at = view.position + view.forward();
         scene.camera.up = glm::vec3(0, 1, 0);

@@ -31,6 +31,14 @@ enum class WindowAction {
     turn_down,   // down arrow
     brighter,    // + (= and keypad +)
     darker,      // - (and keypad -)
+    rain_more,   // R: falling rain's rate up
+    rain_less,   // F
+    wind_west,   // Z: the wind's x component down
+    wind_east,   // X
+    lamps_up,    // L: every lamp's and spot's intensity up
+    lamps_down,  // K
+    sun_up,      // T: the sun's elevation up (the time of day)
+    sun_down,    // G
     quit,        // Esc
     count
 };
@@ -42,10 +50,15 @@ inline constexpr double kTapSeconds = 0.1;
 inline constexpr double kMoveSpeed = 10.0;         // m/s
 inline constexpr double kTurnSpeed = 1.0;          // rad/s
 inline constexpr double kExposurePerSecond = 4.0;  // the exposure's factor per second held
+inline constexpr double kRainPerSecond = 2.0;      // the rain rate's factor per second held
+inline constexpr double kWindPerSecond = 5.0;      // m/s per second held
+inline constexpr double kLampsPerSecond = 2.0;     // the lamps' factor per second held
+inline constexpr double kSunPerSecond = 0.2;       // rad of elevation per second held
 
 // The keys, for the window's title and the demo's --help.
 inline constexpr const char* kWindowKeysHelp =
-    "W/S forward/back, A/D left/right, Q/E down/up, arrow keys turn, +/- exposure, Esc quits";
+    "W/S forward/back, A/D left/right, Q/E down/up, arrow keys turn, +/- exposure, R/F rain, Z/X wind, "
+    "L/K lamps, T/G sun, Esc quits";
 
 // How long each action was held over one frame's interval (seconds).
 struct HeldKeys {
@@ -136,6 +149,31 @@ inline bool apply_window_keys(const HeldKeys& keys, WindowView& view) {
     if (keys[A::brighter] == 0.0 && keys[A::darker] == 0.0) return false;
     view.exposure = float(double(view.exposure) * std::pow(kExposurePerSecond, stops));
     return true;
+}
+
+// The weather the window's keys have set, relative to the scene's: factors
+// on the falling rain's rate and on the lamps' intensities, and offsets of
+// the wind's x component (m/s) and of the sun's elevation (rad).
+struct WindowWeather {
+    double rain_factor = 1.0;
+    double wind_east = 0.0;
+    double lamp_factor = 1.0;
+    double sun_elevation = 0.0;
+};
+
+// The weather after one frame's held keys: R/F multiply the rain rate by
+// kRainPerSecond per second, Z/X move the wind by kWindPerSecond, L/K the lamps
+// by kLampsPerSecond, T/G the sun by kSunPerSecond. Returns whether it changed.
+inline bool apply_weather_keys(const HeldKeys& keys, WindowWeather& w) {
+    using A = WindowAction;
+    auto net = [&](A plus, A minus) { return keys[plus] - keys[minus]; };
+    const WindowWeather before = w;
+    w.rain_factor = std::clamp(w.rain_factor * std::pow(kRainPerSecond, net(A::rain_more, A::rain_less)), 1e-4, 1e4);
+    w.wind_east += kWindPerSecond * net(A::wind_east, A::wind_west);
+    w.lamp_factor = std::clamp(w.lamp_factor * std::pow(kLampsPerSecond, net(A::lamps_up, A::lamps_down)), 0.0, 1e6);
+    w.sun_elevation += kSunPerSecond * net(A::sun_up, A::sun_down);
+    return w.rain_factor != before.rain_factor || w.wind_east != before.wind_east ||
+           w.lamp_factor != before.lamp_factor || w.sun_elevation != before.sun_elevation;
 }
 
 // The window's title: the keys, and the exposure shown.

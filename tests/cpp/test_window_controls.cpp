@@ -90,9 +90,28 @@ void test_held_keys_move_turn_and_expose() {
     CHECK(view.pitch == 1.5f);
 }
 
+void test_weather_keys_scale_the_rain_and_lamps_and_move_the_wind_and_sun() {
+    airlight::WindowWeather weather;
+    HeldKeys held;
+    CHECK(!airlight::apply_weather_keys(held, weather));  // nothing held: nothing changes
+    held.seconds[std::size_t(WindowAction::rain_more)] = 1.0;
+    held.seconds[std::size_t(WindowAction::wind_west)] = 0.5;
+    held.seconds[std::size_t(WindowAction::lamps_down)] = 2.0;
+    held.seconds[std::size_t(WindowAction::sun_up)] = 0.25;
+    CHECK(airlight::apply_weather_keys(held, weather));
+    CHECK(near(weather.rain_factor, airlight::kRainPerSecond));
+    CHECK(near(weather.wind_east, -0.5 * airlight::kWindPerSecond));
+    CHECK(near(weather.lamp_factor, 1.0 / (airlight::kLampsPerSecond * airlight::kLampsPerSecond)));
+    CHECK(near(weather.sun_elevation, 0.25 * airlight::kSunPerSecond));
+    held = HeldKeys{};
+    held.seconds[std::size_t(WindowAction::rain_less)] = 1e3;  // the factor stays within its bounds
+    airlight::apply_weather_keys(held, weather);
+    CHECK(weather.rain_factor == 1e-4);
+}
+
 void test_the_title_lists_the_keys() {
     const std::string title = airlight::window_title(0.0123f);
-    for (const char* key : {"W/S", "A/D", "Q/E", "arrow", "+/-", "Esc"})
+    for (const char* key : {"W/S", "A/D", "Q/E", "arrow", "+/-", "R/F", "Z/X", "L/K", "T/G", "Esc"})
         CHECK_MSG(title.find(key) != std::string::npos, title);
     CHECK_MSG(title.find("exposure 0.0123") != std::string::npos, title);
 }
@@ -103,6 +122,7 @@ int main() {
     test_a_tap_between_frames_is_not_lost();
     test_held_keys_count_their_time_in_each_frame();
     test_held_keys_move_turn_and_expose();
+    test_weather_keys_scale_the_rain_and_lamps_and_move_the_wind_and_sun();
     test_the_title_lists_the_keys();
     return airlight_test::test_result("test_window_controls");
 }
