@@ -91,6 +91,16 @@ double rain_draw_weight(const FallingRain& rain, double d_mm, double dist) {
     return x * x * (3.0 - 2.0 * x);
 }
 
+double rain_drawn_cross_section(const FallingRain& rain, double dist) {
+    if (!(rain.rate > 0.0f)) return 0.0;
+    const double lam = marshall_palmer_slope(rain.rate);
+    // w(D, dist) has kinks where dist = r(D) and 0.75 r(D): many panels (eq. 2.3).
+    return integrate(RAIN_DROP_MIN_MM, RAIN_DROP_MAX_MM, [&](double d) {
+        return MARSHALL_PALMER_N0 * std::exp(-lam * d) * rain_draw_weight(rain, d, dist) * numerics::kPi / 4.0 * d * d *
+               1e-6;
+    });
+}
+
 std::vector<RainDrop> rain_drops(const FallingRain& rain, const glm::dvec3& camera, double exposure,
                                  const std::function<bool(const RainDrop&)>& keep) {
     std::vector<RainDrop> drops;

@@ -42,6 +42,11 @@ double rain_water_content(double rate, double lo_mm, double hi_mm);
 double rain_draw_distance(const FallingRain& rain, double d_mm);
 double rain_draw_weight(const FallingRain& rain, double d_mm, double dist);
 
+// The drawn drops' geometric cross-section per m^3 at distance `dist` from the
+// camera (1/m; eq. 2.3): integral of N(D) w(D, dist) pi D^2 / 4 over the drawn
+// diameters, the expected share of a ray's length they cover.
+double rain_drawn_cross_section(const FallingRain& rain, double dist);
+
 struct RainDrop {
     glm::dvec3 position;   // m, world, at the middle of the exposure
     glm::dvec3 velocity;   // m/s

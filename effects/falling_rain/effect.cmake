@@ -17,6 +17,7 @@ set(EFFECT_TABLES
     drop_optics       # the drop's phase function over theta, RGB
     rain_drops        # the frame's drops, two RGBA texels each (streak start, diameter; streak end, weight)
     rain_tiles        # the screen tiles' offsets, then their lists of drop indices
+    rain_near_depth   # the optical depth of the medium's rain the drawn drops stand for, against distance
     rain_environment  # the light arriving at the camera from each direction, lamps' spheres left out (grid pass)
     rain_surround     # that light seen through a drop along each view direction (grid pass)
     rain_light)       # each drop's radiance toward the camera (grid pass)

@@ -132,3 +132,12 @@ vec2 rain_pixel_coverage(vec3 s, vec3 e, int x, int row, float w, float drop_rad
     }
     return vec2(total, 0.5f * (lo + hi));
 }
+
+// The optical depth of the medium's rain between the camera and distance t
+// that the drawn drops stand for (eq. 2.4), linear between the table's texels.
+float rain_near_optical_depth(float t) {
+    float reach = frame.falling_rain.near_depth.x;
+    float c = clamp(t / reach, 0.0f, 1.0f) * float(RAIN_NEAR_DEPTH_TEXELS - 1);
+    int i = min(int(c), RAIN_NEAR_DEPTH_TEXELS - 2);
+    return mix(table_texel(TABLE_RAIN_NEAR_DEPTH, i, 0), table_texel(TABLE_RAIN_NEAR_DEPTH, i + 1, 0), c - float(i));
+}

@@ -12,6 +12,7 @@
 #include "numerics.hpp"
 #include "rainbow.hpp"
 #include "screen_tiles.hpp"
+#include "sky.hpp"
 
 namespace airlight {
 
@@ -110,6 +111,27 @@ void pack_falling_rain_frame(const Scene& scene, FrameData& data) {
     data.use_table(shader::TABLE_RAIN_DROPS, row_table("rain_drops", 4, shader::RAIN_ROW_TEXELS, std::move(texels)));
     data.use_table(shader::TABLE_RAIN_TILES,
                    row_table("rain_tiles", 1, shader::RAIN_ROW_TEXELS, screen_tile_texels(tiles)));
+    // The drops drawn stand for the medium's rain near the camera (eq. 2.4): its optical depth from the
+    // camera to each distance, which the streaks' occlusion replaces, tabulated over [0, radius].
+    const Atmosphere& atmosphere = scene.atmosphere;
+    if (atmosphere.rain.present && camera.y < double(atmosphere.rain.top)) {
+        const double sigma_medium = rain_extinction(atmosphere.rain.rate) * double(atmosphere.rain.density_scale);
+        const int n = shader::RAIN_NEAR_DEPTH_TEXELS;
+        const double step = double(rain.radius) / (n - 1);
+        std::vector<float> depth(size_t(n), 0.0f);
+        double tau = 0.0, before = 0.0;
+        for (int i = 1; i < n; ++i) {
+            // Trapezoids in distance; nothing is drawn nearer than RAIN_NEAR.
+            const double r = i * step;
+            const double here =
+                r < double(shader::RAIN_NEAR) ? 0.0 : std::min(rain_drawn_cross_section(rain, r), sigma_medium);
+            tau += 0.5 * (before + here) * step;
+            before = here;
+            depth[size_t(i)] = float(tau);
+        }
+        data.use_table(shader::TABLE_RAIN_NEAR_DEPTH, row_table("rain_near_depth", 1, n, std::move(depth)));
+        data.frame.falling_rain.near_depth = glm::vec4(rain.radius, 1.0f, 0.0f, 0.0f);
+    }
     data.tables[size_t(shader::TABLE_DROP_OPTICS)] = &table_built_once("drop_optics", build_drop_optics);
     data.grid_passes.push_back({shader::TABLE_RAIN_ENVIRONMENT, shader::RAIN_ENV_WIDTH, shader::RAIN_ENV_HEIGHT, 4});
     data.grid_passes.push_back({shader::TABLE_RAIN_SURROUND, shader::RAIN_ENV_WIDTH, shader::RAIN_ENV_HEIGHT, 4});

@@ -14,6 +14,10 @@ CONST int RAIN_ENV_HEIGHT = 32;
 // Streaks are cut at this distance in front of the camera (m).
 CONST float RAIN_NEAR = 0.05f;
 
+// Texels of the near rain's compensated optical depth over [0, radius] (section 2).
+CONST int RAIN_NEAR_DEPTH_TEXELS = 256;
+
 struct FallingRainGpu {
-    ivec4 tiles;  // x, y: screen tiles along x and down, z: drops, w: a tile's edge in pixels
+    ivec4 tiles;      // x, y: screen tiles along x and down, z: drops, w: a tile's edge in pixels
+    vec4 near_depth;  // x: the rain_near_depth table's reach (m); y: 1 where the medium's rain is compensated
 };

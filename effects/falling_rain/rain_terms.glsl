@@ -79,7 +79,8 @@ vec3 falling_rain_pixel_cores(int x, int row, vec3 radiance) {
     int tile = (row / size) * frame.falling_rain.tiles.x + x / size;
     int begin = rain_index_at(tile);
     int end = rain_index_at(tile + 1);
-    if (begin == end) return radiance;
+    bool compensated = frame.falling_rain.near_depth.y > 0.0f;
+    if (begin == end && !compensated) return radiance;
     vec3 origin = vec3(frame.camera_position);
     vec3 dir = camera_ray_direction(x, row);
     float t_hit = NO_HIT;
@@ -87,6 +88,13 @@ vec3 falling_rain_pixel_cores(int x, int row, vec3 radiance) {
         int hit = -1;
         vec3 n;
         t_hit = trace_surfaces(origin, dir, hit, n);
+    }
+    if (compensated) {
+        // The medium's rain that the drawn drops stand for, given back (eq. 2.4): on average over the
+        // drops the streaks take exactly this away again.
+        float back = exp(rain_near_optical_depth(t_hit));
+        outputs_attenuate(vec3(back));
+        radiance *= back;
     }
     vec3 f = vec3(frame.camera_forward);
     vec3 u = vec3(frame.camera_up);
