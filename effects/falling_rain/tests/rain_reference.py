@@ -179,3 +179,27 @@ def streak_solid_angle_time(
     d = np.linalg.norm(q - o, axis=1)
     a = 0.5e-3 * diameter_mm
     return float(integrate.simpson(math.pi * a * a / d**2 * np.exp(-sigma_t * d), x=tau))
+
+
+def drawn_optical_depth(rate: float, radius: float, full_diameter: float, near: float = 0.05) -> float:
+    """The drawn drops' expected coverage of a ray from the camera to beyond `radius`: the double integral
+    over distance r and diameter D of N(D) w(D, r) pi D^2 / 4 (physics.md eqs. 2.1-2.3), by adaptive
+    quadrature, with w the smoothstep fade over the outer quarter of r(D) = radius min(1, D / full_diameter).
+    """
+    lam = slope(rate)
+
+    def weight(d: float, r: float) -> float:
+        reach = radius * min(1.0, d / full_diameter)
+        x = min(max((reach - r) / (0.25 * reach), 0.0), 1.0)
+        return x * x * (3 - 2 * x)
+
+    def sigma(r: float) -> float:
+        return integrate.quad(
+            lambda d: N0 * math.exp(-lam * d) * weight(d, r) * math.pi / 4 * d * d * 1e-6,
+            D_MIN,
+            D_MAX,
+            limit=200,
+            points=[full_diameter],
+        )[0]
+
+    return integrate.quad(sigma, near, radius, limit=200)[0]

@@ -317,3 +317,49 @@ def test_frames_change_continuously_as_time_goes_on(renderer):
     step, far = np.abs(b - a).sum(), np.abs(c - a).sum()
     assert a.sum() > 0 and far > 0
     assert step < 0.2 * far, (step, far)
+
+
+def background_behind_the_streaks(scene: dict[str, Any], seeds: int) -> tuple[float, float]:
+    """The mean over frames of different seeds of (radiance - the streaks' light) over the same scene's
+    radiance without falling rain, and its standard error."""
+    dry = {k: v for k, v in scene.items() if k != "falling_rain"}
+    base = airlight.render(dry, "cpu").astype(np.float64).mean()
+    ratios = []
+    for seed in range(seeds):
+        wet = copy.deepcopy(scene)
+        wet["falling_rain"]["seed"] = seed
+        out = airlight.render(wet, "cpu", outputs=["radiance", "falling_rain"])
+        ratios.append((out["radiance"].astype(np.float64) - out["falling_rain"]).mean() / base)
+    return float(np.mean(ratios)), float(np.std(ratios, ddof=1) / math.sqrt(seeds))
+
+
+AVERAGE_SCENE: dict[str, Any] = {
+    "film": {"width": 64, "height": 48},
+    "camera": {"position": [0, 1.6, 0], "look_at": [0, 1.6, -10], "up": [0, 1, 0], "fov_y": 50},
+    "falling_rain": {"rate": 50, "time": 1.0},
+    "quality": {"multiple_scattering": False},
+}
+
+
+def test_on_average_streaks_take_away_what_the_drawn_drops_cover():
+    # Without a rain medium the drops are all the rain: on average over the field a pixel's background
+    # is seen through exp(-tau_d), tau_d the drops' expected coverage (physics.md eq. 2.3; a Poisson
+    # field: E[prod(1 - alpha)] = exp(-E[sum alpha])).
+    scene = {**copy.deepcopy(AVERAGE_SCENE), "background": [1.0, 1.0, 1.0]}
+    mean, error = background_behind_the_streaks(scene, 6)
+    expected = math.exp(-ref.drawn_optical_depth(50, 8.0, 2.0))
+    assert expected < 0.995
+    assert abs(mean - expected) < max(4 * error, 5e-4), (mean, expected, error)
+
+
+def test_with_the_atmospheres_rain_the_total_extinction_is_unchanged():
+    # With the atmosphere's rain the drawn drops stand for its near part (eq. 2.4): what they take away
+    # is given back, so on average the background is seen exactly as without them.
+    scene = {
+        **copy.deepcopy(AVERAGE_SCENE),
+        "sky": {"model": "overcast", "zenith_radiance": [0.3, 0.3, 0.3]},
+        "atmosphere": {"rain": {"rate": 50}},
+    }
+    scene["falling_rain"] = {"time": 1.0}  # the atmosphere's rate
+    mean, error = background_behind_the_streaks(scene, 6)
+    assert abs(mean - 1.0) < max(4 * error, 5e-4), (mean, error)

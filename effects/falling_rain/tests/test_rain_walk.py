@@ -26,8 +26,18 @@ def test_rain_walk_renders_one_frame_per_24th_of_a_second(tmp_path: Path) -> Non
     path = tmp_path / "rain.json"
     path.write_text(json.dumps(SCENE))
     out = tmp_path / "frames"
-    proc = run_demo("--scene", str(path), "--out", str(out), "--backend", "cpu", "--sequence", "rain-walk",
-                    "--frames", "3")
+    proc = run_demo(
+        "--scene",
+        str(path),
+        "--out",
+        str(out),
+        "--backend",
+        "cpu",
+        "--sequence",
+        "rain-walk",
+        "--frames",
+        "3",
+    )
     assert proc.returncode == 0, proc.stderr
     names = sorted(p.name for p in out.iterdir())
     assert names == [f"frame_{k:03d}_{2.0 + k / 24:.3f}s.png" for k in range(3)]
