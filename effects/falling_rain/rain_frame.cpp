@@ -5,6 +5,8 @@
 #include <algorithm>
 #include <cmath>
 #include <glm/glm.hpp>
+#include <stdexcept>
+#include <string>
 
 #include "drop_optics.hpp"
 #include "drops.hpp"
@@ -17,6 +19,9 @@
 namespace airlight {
 
 namespace {
+
+// The mean screen-tile list length above which the tiles are made finer (section 5).
+constexpr int RAIN_TILE_LIST = 64;
 
 // The optics table (eq. 4.3): the phase function f(theta) over
 // DROP_OPTICS_BINS bins of theta; RGB for water at 610, 550 and 465 nm.
@@ -101,13 +106,25 @@ void pack_falling_rain_frame(const Scene& scene, FrameData& data) {
         const glm::dvec3 b = d.position + 0.5 * exposure * d.velocity - camera;
         for (double v : {a.x, a.y, a.z, 1e-3 * d.diameter, b.x, b.y, b.z, d.weight}) texels.push_back(float(v));
     }
-    const ScreenTiles tiles = bin_screen_rectangles(
-        rects, width, height, shader::RAIN_TILE_SIZE, size_t(1) << 24,
+    // Tiles of RAIN_TILE_SIZE pixels, halved while a tile's list averages more than RAIN_TILE_LIST
+    // streaks (a small film sees many streaks a pixel; section 5), as long as the lists' bound holds.
+    const std::string too_many =
         "falling_rain: the streaks in view cover more than 2^24 screen-tile entries (the tile lists' memory bound); "
-        "lower falling_rain.radius or camera.exposure_time, or use a smaller film");
+        "lower falling_rain.radius or camera.exposure_time, or use a smaller film";
+    int tile_size = shader::RAIN_TILE_SIZE;
+    ScreenTiles tiles = bin_screen_rectangles(rects, width, height, tile_size, size_t(1) << 24, too_many);
+    while (tile_size > 1 && tiles.entries.size() > size_t(RAIN_TILE_LIST) * tiles.offsets.size()) {
+        try {
+            ScreenTiles finer = bin_screen_rectangles(rects, width, height, tile_size / 2, size_t(1) << 24, too_many);
+            tiles = std::move(finer);
+            tile_size /= 2;
+        } catch (const std::runtime_error&) {
+            break;
+        }
+    }
     const int count = int(drops.size());
     data.features.falling_rain = true;
-    data.frame.falling_rain.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, count, shader::RAIN_TILE_SIZE);
+    data.frame.falling_rain.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, count, tile_size);
     data.use_table(shader::TABLE_RAIN_DROPS, row_table("rain_drops", 4, shader::RAIN_ROW_TEXELS, std::move(texels)));
     data.use_table(shader::TABLE_RAIN_TILES,
                    row_table("rain_tiles", 1, shader::RAIN_ROW_TEXELS, screen_tile_texels(tiles)));

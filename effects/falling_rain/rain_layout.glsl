@@ -4,7 +4,7 @@
 
 // Texels per row of the drop, tile and light tables.
 CONST int RAIN_ROW_TEXELS = 2048;
-// The screen tiles' edge in pixels (section 5).
+// The screen tiles' edge in pixels, halved on small films (section 5).
 CONST int RAIN_TILE_SIZE = 16;
 // Bins of the drop's phase function over theta in [0, pi] (section 4).
 CONST int DROP_OPTICS_BINS = 720;
