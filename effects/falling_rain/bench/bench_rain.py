@@ -2,7 +2,7 @@
 no drop is drawn, and the per-frame tables' memory against their stated bound.
 
     .venv/bin/python effects/falling_rain/bench/bench_rain.py [--width 640 --height 360]
-        [--backends cpu gl] [--repeats 3] [--quick]
+        [--backends cpu,gl] [--repeats 3] [--quick]
         [--out effects/falling_rain/docs/bench_rain.txt]
         [--plot effects/falling_rain/docs/bench_rain.png]
 
@@ -11,17 +11,21 @@ a homogeneous fog) with falling_rain {rate, time 10 s, seed 1} added, the other 
 defaults (radius 8 m, full_diameter 2 mm, no wind, camera.exposure_time 1/60 s). Each scene is
 rendered once to warm the renderer (tables built, shader variants compiled), then the scenes of a
 table are rendered in turn, `--repeats` rounds (three times as many for the cheap frames of "no drop
-drawn"); a time is the median over the rounds and a ratio the median of the rounds' ratios (drift on
-a shared machine hits both sides alike). "Drops in the field" is len(airlight._core.rain_drops(scene)):
-every drop within its draw distance, in any direction. No output or table statistic of the renderer
-tells how many of them it drew (airlight.table_stats lists the tables built once, not the per-frame
-rain_drops/rain_tiles), so "drops in view", the tile entries and the tables' bytes are computed here
-by the frame's own test (rain_frame.cpp: a streak is kept when its pixel rectangle meets the film and
-its weight is positive), checked against the falling_rain layer of a sparse field's render. "Where
-the time goes" renders the 25 mm/h frame without the street's surfaces (no shadow test per drop and
-lamp) and without its lamps (drops lit by a dim background alone). GL is Mesa's llvmpipe here: a
-software rasteriser on the same CPU cores, no GPU. Absolute times on a shared 2-core machine are
-noisy; compare ratios.
+drawn"). Each frame is timed twice: wall-clock seconds, and the process's CPU seconds (all threads:
+the CPU backend's and llvmpipe's), which another job on the machine barely changes where it can
+double the wall time. A time is the median over the rounds; a ratio is the median of the rounds'
+ratios of CPU seconds (drift hits both sides alike).
+
+"Drops in the field" is len(airlight._core.rain_drops(scene)): every drop within its draw distance,
+in any direction. No output or table statistic of the renderer tells how many of them it drew
+(airlight.table_stats lists the tables built once, not the per-frame rain_drops/rain_tiles), so
+"drops in view", the tile entries and the tables' bytes are computed here by the frame's own test
+(rain_frame.cpp: a streak is kept when its pixel rectangle meets the film and its weight is
+positive), checked against the falling_rain layer of a sparse field's render. "Where the time goes"
+renders the 25 mm/h frame without the street's surfaces (no shadow test per drop and lamp) and
+without its lamps (drops lit by a dim background alone). GL is Mesa's llvmpipe here: a software
+rasteriser on the same CPU cores, no GPU. Absolute times on a shared 2-core machine are noisy (the
+load average is printed at the start and the end); compare the CPU-time ratios.
 """
 
 from __future__ import annotations
@@ -70,27 +74,39 @@ def street(width: int, height: int, rate: float | None = None, lights: bool = Tr
 
 
 FALLBACK: dict[str, int] = {}  # backend -> the most pixels llvmpipe's loop limiter sent back to the CPU
+TOTAL = np.zeros(2)  # wall and CPU seconds of every timed frame
 
 
-def timed(renderer: airlight.Renderer, scene: dict[str, Any]) -> float:
-    start = time.perf_counter()
+WALL, CPU = 0, 1  # the last axis of rounds()'s times
+
+
+def timed(renderer: airlight.Renderer, scene: dict[str, Any]) -> tuple[float, float]:
+    """One frame's wall-clock seconds and the process's CPU seconds (all its threads)."""
+    wall, cpu = time.perf_counter(), time.process_time()
     renderer.render(scene)
-    seconds = time.perf_counter() - start
+    wall, cpu = time.perf_counter() - wall, time.process_time() - cpu
     FALLBACK[renderer.backend] = max(FALLBACK.get(renderer.backend, 0), renderer.cpu_fallback_pixels)
-    return seconds
+    TOTAL[:] += (wall, cpu)
+    return wall, cpu
 
 
 def rounds(renderer: airlight.Renderer, scenes: list[dict[str, Any]], repeats: int, label: str) -> np.ndarray:
-    """Times (repeats x scenes): each scene rendered once to warm, then all of them in turn per round."""
+    """Times (repeats x scenes x [wall, CPU]): each scene rendered once to warm, then all of them in
+    turn per round."""
     for scene in scenes:
         renderer.render(scene)
-    times = np.zeros((repeats, len(scenes)))
+    times = np.zeros((repeats, len(scenes), 2))
     for k in range(repeats):
         for i, scene in enumerate(scenes):
             times[k, i] = timed(renderer, scene)
-        print(f"  {label}: round {k + 1}/{repeats}: " + " ".join(f"{t:.2f}" for t in times[k]),
-              file=sys.stderr, flush=True)
+        print(f"  {label}: round {k + 1}/{repeats} (wall/CPU s): "
+              + " ".join(f"{w:.2f}/{c:.2f}" for w, c in times[k]), file=sys.stderr, flush=True)
     return times
+
+
+def ratio(times: np.ndarray, i: int, ref: int) -> float:
+    """The median over the rounds of scene i's CPU seconds over scene ref's."""
+    return float(np.median(times[:, i, CPU] / times[:, ref, CPU]))
 
 
 def camera_basis(scene: dict[str, Any]) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
@@ -175,8 +191,9 @@ def header(args: argparse.Namespace, renderers: dict[str, airlight.Renderer]) ->
              "Backends: " + "; ".join(names[b] for b in renderers) + ".",
              f"Scene: crane_searchlight at {args.width}x{args.height}, falling_rain "
              f"{{rate, time {RAIN_TIME:g}, seed {SEED}}} (radius 8 m, full_diameter 2 mm, "
-             f"exposure 1/60 s). Times: median of {args.repeats} rounds after one warm frame per scene; "
-             "ratios: median of the rounds' ratios.\n"]
+             f"exposure 1/60 s). Times: median of {args.repeats} rounds after one warm frame per scene, "
+             "wall-clock and CPU (the process's CPU seconds, all threads); ratios: median of the rounds' "
+             "ratios of CPU seconds.\n"]
     return lines
 
 
@@ -185,50 +202,55 @@ def sweep(args: argparse.Namespace, renderers: dict[str, airlight.Renderer], lin
     rows: list[dict[str, Any]] = [{"rate": r} for r in args.rates]
     for row in rows:
         scene = street(args.width, args.height, row["rate"])
-        start = time.perf_counter()
-        drops = airlight._core.rain_drops(scene)
-        row["field_seconds"] = time.perf_counter() - start
+        field = []
+        for _ in range(args.repeats):
+            start = time.perf_counter()
+            drops = airlight._core.rain_drops(scene)
+            field.append(time.perf_counter() - start)
+        row["field_seconds"] = float(np.median(field))
         row["field"] = len(drops["id"])
         row.update(frame_tables(scene, streak_rectangles(scene, drops)))
     scenes = [street(args.width, args.height)] + [street(args.width, args.height, r) for r in args.rates]
     tiles = -(-args.width // TILE) * -(-args.height // TILE)
-    none: dict[str, float] = {}
+    none: dict[str, tuple[float, float]] = {}
     for b, renderer in renderers.items():
         t = rounds(renderer, scenes, args.repeats, f"{b} {args.width}x{args.height}")
-        none[b] = float(np.median(t[:, 0]))
+        none[b] = (float(np.median(t[:, 0, WALL])), float(np.median(t[:, 0, CPU])))
         for i, row in enumerate(rows, start=1):
-            row[b] = float(np.median(t[:, i]))
-            row[b + "_ratio"] = float(np.median(t[:, i] / t[:, 0]))
+            row[b] = (float(np.median(t[:, i, WALL])), float(np.median(t[:, i, CPU])))
+            row[b + "_ratio"] = ratio(t, i, 0)
     head = ("| rate mm/h | drops in the field | drops in view | tile entries (mean per tile) | tables MiB "
             "| field s |")
     for b in renderers:
-        head += f" {b} frame s | {b} / no rain | {b} us per drop in view |"
+        head += f" {b} wall s | {b} CPU s | {b} / no rain | {b} CPU us per drop |"
     lines.append(head)
     lines.append("|" + "---|" * (head.count("|") - 1))
     text = "| no falling_rain | - | - | - | - | - |"
     for b in renderers:
-        text += f" {none[b]:.2f} | 1 | - |"
+        text += f" {none[b][WALL]:.2f} | {none[b][CPU]:.2f} | 1 | - |"
     lines.append(text)
     for row in rows:
         text = (f"| {row['rate']:g} | {row['field']} | {row['in_view']} "
                 f"| {row['tile_entries']} ({row['tile_entries'] / tiles:.0f}) "
                 f"| {row['bytes'] / MIB:.2f} | {row['field_seconds']:.3f} |")
         for b in renderers:
-            per_drop = (row[b] - none[b]) / max(row["in_view"], 1) * 1e6
-            text += f" {row[b]:.2f} | {row[b + '_ratio']:.2f} | {per_drop:.0f} |"
+            per_drop = (row[b][CPU] - none[b][CPU]) / max(row["in_view"], 1) * 1e6
+            text += f" {row[b][WALL]:.2f} | {row[b][CPU]:.2f} | {row[b + '_ratio']:.2f} | {per_drop:.0f} |"
         lines.append(text)
     lines.append(f"\nTiles: {TILE}x{TILE} pixels, {tiles} on the film; each pixel tests every streak of its "
                  "tile's list. \"field s\": airlight._core.rain_drops alone (every drop within its "
                  "distance, one thread), which each rain frame also draws before keeping those in view. "
-                 "\"us per drop\": (frame - no rain) / drops in view.")
+                 "\"CPU us per drop\": (CPU s - no rain's) / drops in view.")
     if "cpu" in renderers and "gl" in renderers:
-        speed = ", ".join(f"{r['rate']:g} mm/h {r['gl'] / r['cpu']:.2f}" for r in rows)
-        slower = [r["rate"] for r in rows if r["gl"] > r["cpu"]]
+        def compare(k: int) -> str:
+            return f"no rain {none['gl'][k] / none['cpu'][k]:.2f}; " + ", ".join(
+                f"{r['rate']:g} mm/h {r['gl'][k] / r['cpu'][k]:.2f}" for r in rows)
+        slower = [r["rate"] for r in rows if r["gl"][WALL] > r["cpu"][WALL]]
         verdict = ("slower than the CPU backend at every rain rate" if len(slower) == len(rows) else
                    f"slower than the CPU backend at {len(slower)} of {len(rows)} rain rates")
-        lines.append(f"GL (llvmpipe) / CPU frame time: no rain {none['gl'] / none['cpu']:.2f}; {speed}. "
+        lines.append(f"GL (llvmpipe) / CPU backend, wall time: {compare(WALL)}; CPU time: {compare(CPU)}. "
                      f"llvmpipe runs on the same {os.cpu_count()} cores as the CPU backend (no GPU here): "
-                     f"GL is {verdict}.")
+                     f"in wall time GL is {verdict}.")
     if "gl" in renderers:
         lines.append(f"GL pixels cut by llvmpipe's loop limiter and recomputed on the CPU "
                      f"(Renderer.cpu_fallback_pixels), most in any frame so far: {FALLBACK.get('gl', 0)}.")
@@ -275,8 +297,8 @@ def time_split(args: argparse.Namespace, renderers: dict[str, airlight.Renderer]
             elif name.startswith("lights"):
                 s["lights"], s["background"] = [], [0.01, 0.01, 0.01]
         cases.append((name, pair))
-    head = "| scene | " + " | ".join(f"{b} no rain s | {b} rain s | {b} rain - no rain s"
-                                     for b in renderers) + " |"
+    head = "| scene (CPU seconds) | " + " | ".join(f"{b} no rain | {b} rain | {b} rain - no rain"
+                                                   for b in renderers) + " |"
     lines.append(head)
     lines.append("|" + "---|" * (head.count("|") - 1))
     scenes = [s for _, pair in cases for s in pair]
@@ -284,7 +306,7 @@ def time_split(args: argparse.Namespace, renderers: dict[str, airlight.Renderer]
     for i, (name, _) in enumerate(cases):
         text = f"| {name} |"
         for b in renderers:
-            t = results[b]
+            t = results[b][:, :, CPU]
             text += (f" {np.median(t[:, 2 * i]):.2f} | {np.median(t[:, 2 * i + 1]):.2f} "
                      f"| {np.median(t[:, 2 * i + 1] - t[:, 2 * i]):.2f} |")
         lines.append(text)
@@ -306,7 +328,7 @@ def costs_nothing(args: argparse.Namespace, renderers: dict[str, airlight.Render
               "fixed passes)", few, 0),
              ("lights [] (no light), no falling_rain", street(w, h, lights=False), None),
              ("lights [] (no light), falling_rain 25 mm/h", street(w, h, 25, lights=False), 3)]
-    head = "| scene | " + " | ".join(f"{b} frame s | {b} / no rain" for b in renderers) + " |"
+    head = "| scene | " + " | ".join(f"{b} wall s | {b} CPU s | {b} / no rain" for b in renderers) + " |"
     lines.append(head)
     lines.append("|" + "---|" * (head.count("|") - 1))
     results = {b: rounds(r, [c[1] for c in cases], 3 * args.repeats, f"{b} no drops")
@@ -315,8 +337,8 @@ def costs_nothing(args: argparse.Namespace, renderers: dict[str, airlight.Render
         text = f"| {name} |"
         for b in renderers:
             t = results[b]
-            ratio = "1" if ref is None else f"{np.median(t[:, i] / t[:, ref]):.3f}"
-            text += f" {np.median(t[:, i]):.3f} | {ratio} |"
+            r = "1" if ref is None else f"{ratio(t, i, ref):.3f}"
+            text += f" {np.median(t[:, i, WALL]):.3f} | {np.median(t[:, i, CPU]):.3f} | {r} |"
         lines.append(text)
     probe = ("import json, sys, airlight; airlight.render(json.loads(sys.argv[1]), backend='cpu', width=64, "
              "height=36); print(json.dumps(sorted(airlight.table_stats())))")
@@ -355,18 +377,21 @@ def plot(rows: list[dict], backends: list[str], path: str, size: str) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    fig, ax = plt.subplots(figsize=(6.5, 4.2))
+    fig, axes = plt.subplots(1, 2, figsize=(10, 4.2))
     rates = [r["rate"] for r in rows]
-    for b, color in zip(backends, ["C0", "C1"]):
-        ax.plot(rates, [r[b] for r in rows], "o-", color=color, label=f"{b}: frame with falling rain")
-        ax.axhline(rows[0]["none"][b], color=color, ls="--", lw=1, label=f"{b}: no falling_rain")
-    ax.set_xscale("log")
-    ax.set_ylim(bottom=0)
-    ax.set_xlabel("rain rate (mm/h)")
-    ax.set_ylabel("seconds per frame")
-    ax.set_title(f"crane_searchlight + falling_rain, {size} (gl: llvmpipe, CPU)", fontsize=9)
-    ax.grid(True, which="both", alpha=0.3)
-    ax.legend(fontsize=7)
+    for ax, k, what in zip(axes, (WALL, CPU), ("wall-clock seconds per frame",
+                                               "CPU seconds per frame (all threads)")):
+        for b, color in zip(backends, ["C0", "C1"]):
+            ax.plot(rates, [r[b][k] for r in rows], "o-", color=color, label=f"{b}: with falling rain")
+            ax.axhline(rows[0]["none"][b][k], color=color, ls="--", lw=1, label=f"{b}: no falling_rain")
+        ax.set_xscale("log")
+        ax.set_ylim(bottom=0)
+        ax.set_xlabel("rain rate (mm/h)")
+        ax.set_ylabel(what)
+        ax.grid(True, which="both", alpha=0.3)
+        ax.legend(fontsize=7)
+    fig.suptitle(f"crane_searchlight + falling_rain, {size}, {os.cpu_count()} cores "
+                 "(gl: Mesa llvmpipe, on the CPU)", fontsize=9)
     fig.tight_layout()
     Path(path).parent.mkdir(parents=True, exist_ok=True)
     fig.savefig(path, dpi=120)
@@ -399,7 +424,9 @@ def main() -> None:
         plot(rows, backends, args.plot, f"{args.width}x{args.height}")
         lines.append(f"Plot: {args.plot}\n")
     lines.append(f"Benchmark wall time: {time.perf_counter() - start:.0f} s; load average (1 min) "
-                 f"{load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end.")
+                 f"{load:.2f} at the start, {os.getloadavg()[0]:.2f} at the end; CPU / wall seconds over "
+                 f"all timed frames {TOTAL[CPU] / TOTAL[WALL]:.2f} (the cores this process had on average: "
+                 f"{os.cpu_count()} when it has the machine to itself).")
     text = "\n".join(lines)
     print(text)
     if args.out:
