@@ -26,6 +26,10 @@
   side; rain_ends.png: the end of the heavy shower (airlight-demo --sequence
   rain-ends, 6 frames at 320x200): the sun comes out, the bow appears and
   fades with the drops.
+- falling_rain.png: the source paper's figure 6 (issue 23): the night street with the crane's
+  searchlight in clear weather (scenes/falling_rain_night_light.json without its falling rain), in
+  heavy rain and in light rain (scenes/falling_rain_night_*.json), 480 x 270 at one exposure (the
+  clear street's automatic one), above the same frames' left lamp enlarged 3 times.
 - light_shafts.png: the light shafts' presets (issue 20; scenes/shafts_*.json, 320 x 180 each):
   each with shafts (left) and with ``quality.shafts`` "off" (right), one row per preset, each
   shown with its scene's display settings.
@@ -170,10 +174,29 @@ def clouds_figure(backend: str, out: Path) -> None:
     Image.fromarray(np.concatenate(rows[:-1], axis=0)).save(out)
 
 
+def falling_rain_figure(backend: str, out: Path) -> None:
+    """Figure 6: the night street clear, in heavy rain and in light rain, one exposure; below, the
+    region around the nearest left lamp of each, enlarged 3 times."""
+    clear = airlight.preset("falling_rain_night_light")
+    del clear["falling_rain"]
+    scenes = [clear, airlight.preset("falling_rain_night_heavy"), airlight.preset("falling_rain_night_light")]
+    with airlight.Renderer(backend) as r:
+        images = [r.render(scene, width=480, height=270) for scene in scenes]
+    exposure = airlight.auto_exposure(images[0])
+    shown = [airlight.display(image, exposure=exposure, dither=False) for image in images]
+    crops = [np.kron(s[30:120, 40:200], np.ones((3, 3, 1), np.uint8))[:, :480] for s in shown]
+    gap = np.full((270, 6, 3), 255, np.uint8)
+    top = np.concatenate([shown[0], gap, shown[1], gap, shown[2]], axis=1)
+    gap = np.full((crops[0].shape[0], 6, 3), 255, np.uint8)
+    bottom = np.concatenate([crops[0], gap, crops[1], gap, crops[2]], axis=1)
+    between = np.full((6, top.shape[1], 3), 255, np.uint8)
+    Image.fromarray(np.concatenate([top, between, bottom], axis=0)).save(out)
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="auto")
-    ap.add_argument("--only", choices=["rainbows", "daytime", "night", "shafts", "clouds"],
+    ap.add_argument("--only", choices=["rainbows", "daytime", "night", "shafts", "clouds", "falling_rain"],
                     help="render only these figures")
     args = ap.parse_args()
     IMAGES.mkdir(parents=True, exist_ok=True)
@@ -182,6 +205,9 @@ def main() -> None:
         return
     if args.only == "shafts":
         light_shafts_figure(args.backend, IMAGES / "light_shafts.png")
+        return
+    if args.only == "falling_rain":
+        falling_rain_figure(args.backend, IMAGES / "falling_rain.png")
         return
     if args.only == "clouds":
         clouds_figure(args.backend, IMAGES / "noise_clouds.png")
