@@ -22,6 +22,22 @@ vec4 rain_surround_pass(int x, int y) {
     return vec4(sum * (4.0f * PI / float(RAIN_ENV_WIDTH * RAIN_ENV_HEIGHT)), 1.0f);
 }
 
+// A lamp's or spot's light on the drop at p seen along v (eq. 4.5): its
+// intensity (a spot's times its profile toward p: nothing outside its cone)
+// over the squared distance, no closer than its radius, through the
+// homogeneous medium and the surfaces' hard shadows, times the drop's phase
+// function.
+vec3 rain_lamp_light(vec3 p, vec3 v, vec3 position, float radius, vec3 intensity, bool spot, int spot_index) {
+    vec3 to_light = position - p;
+    float dist = length(to_light);
+    if (!(dist > 0.0f)) return vec3(0.0f);
+    vec3 l = to_light / dist;
+    float profile = spot ? spot_profile_toward(spot_light(spot_index), -l) : 1.0f;
+    if (!(profile > 0.0f)) return vec3(0.0f);
+    if (HAS_SURFACES && segment_occluded(p, l, dist - radius, -1)) return vec3(0.0f);
+    return intensity * (profile / max(dist * dist, radius * radius)) * transmittance(dist) * drop_phase(dot(l, v));
+}
+
 // Grid pass rain_light: drop k = x + RAIN_ROW_TEXELS y's radiance toward the
 // camera at the middle of its streak (eq. 4.5): every lamp's and spot's
 // irradiance (inverse square, the homogeneous medium's attenuation, hard
@@ -37,29 +53,15 @@ vec4 rain_light_pass(int x, int y) {
     if (HAS_POINT_LIGHTS) {
         for (int i = 0; i < point_light_count(); ++i) {
             PointLightGpu lamp = point_light(i);
-            vec3 to_light = vec3(lamp.position_radius) - p;
-            float dist = length(to_light);
-            float radius = lamp.position_radius.w;
-            if (!(dist > 0.0f)) continue;
-            vec3 l = to_light / dist;
-            if (HAS_SURFACES && segment_occluded(p, l, dist - radius, -1)) continue;
-            light += vec3(lamp.intensity) * transmittance(dist) * drop_phase(dot(l, v)) /
-                     max(dist * dist, radius * radius);
+            light += rain_lamp_light(p, v, vec3(lamp.position_radius), lamp.position_radius.w, vec3(lamp.intensity),
+                                     false, 0);
         }
     }
     if (HAS_SPOT_LIGHTS) {
         for (int i = 0; i < spot_light_count(); ++i) {
             SpotLightGpu s = spot_light(i);
-            vec3 to_light = vec3(s.world_position) - p;
-            float dist = length(to_light);
-            float radius = s.relative_position_radius.w;
-            if (!(dist > 0.0f)) continue;
-            vec3 l = to_light / dist;
-            float profile = spot_profile_toward(s, -l);
-            if (!(profile > 0.0f)) continue;
-            if (HAS_SURFACES && segment_occluded(p, l, dist - radius, -1)) continue;
-            light += vec3(s.intensity_edge) * (profile / max(dist * dist, radius * radius)) * transmittance(dist) *
-                     drop_phase(dot(l, v));
+            light += rain_lamp_light(p, v, vec3(s.world_position), s.relative_position_radius.w,
+                                     vec3(s.intensity_edge), true, i);
         }
     }
     vec3 sun = vec3(frame.sky.sun_direction);
