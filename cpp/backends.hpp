@@ -70,6 +70,12 @@ public:
     // `cancel` (optional): polled per tile; once true, throws RenderCancelled.
     void render(const FrameData& data, Image& out, std::vector<size_t>* cut_pixels = nullptr,
                 const std::atomic<bool>* cancel = nullptr);
+    // The outputs of data.grid_passes alone, in order, read back (tests).
+    std::vector<Table2D> grid_passes(const FrameData& data);
+    // The texels of the last frame's grid passes whose loops the driver cut
+    // (the GL loop limit, render.frag): then every grid pass of that frame was
+    // computed again on the CPU.
+    int grid_pass_cut_texels() const;
     // GL_MAX_TEXTURE_SIZE: the display stage's images must fit it on each side.
     int max_texture_size();
     // The display stage on the GPU (see GlDisplayJob).

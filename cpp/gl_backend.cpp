@@ -8,6 +8,7 @@
 #include <algorithm>
 #include <array>
 #include <atomic>
+#include <cstdint>
 #include <cstdlib>
 #include <cstring>
 #include <map>
@@ -180,9 +181,18 @@ std::string fragment_shader_source(const shader::Features& features, int grid_pa
     if (entry.empty())
         throw std::logic_error("airlight: no grid pass fills table slot " + std::to_string(grid_pass_slot));
     return source +
-           "// ---- grid pass\nlayout(location = 0) out vec4 out_texel;\nvoid main() {\n    ivec2 texel = "
-           "ivec2(gl_FragCoord.xy);\n    out_texel = " +
-           entry + "(texel.x, texel.y);\n}\n";
+           "// ---- grid pass\n"
+           "layout(location = 0) out vec4 out_texel;\n"
+           "layout(location = 1) out float out_finished;  // 0 where the loop limiter cut the texel (render.frag)\n"
+           "void main() {\n"
+           "    ivec2 texel = ivec2(gl_FragCoord.xy);\n"
+           "    out_texel = " +
+           entry +
+           "(texel.x, texel.y);\n"
+           "    int guard = 0;\n"
+           "    while (guard < frame.loop_guard_iterations) ++guard;\n"
+           "    out_finished = guard == frame.loop_guard_iterations ? 1.0f : 0.0f;\n"
+           "}\n";
 }
 
 struct GlBackend::State {
@@ -274,23 +284,73 @@ struct GlBackend::State {
     GLuint pass_fbo = 0;
     struct PassTexture {
         GLuint texture = 0;
+        GLuint finished = 0;  // R8: 0 where the driver cut the texel's loops
         int width = 0, height = 0, channels = 0;
     };
+    int grid_pass_cut_texels = 0;  // of the last frame's grid passes (GlBackend::grid_pass_cut_texels)
     std::array<PassTexture, shader::TABLE_COUNT> pass_textures{};
 
-    // Runs `job` (FrameData::grid_passes) into its texture, bound to its table slot's unit.
-    void run_grid_pass(const shader::Features& features, const GridPassJob& job) {
+    // Uploads the frame's uniforms, lights, surfaces, BVH and tables, binds
+    // them, then runs the grid passes in order, each into its slot (read by
+    // the passes after it and the shading pass).
+    void upload_frame(const FrameData& data, const shader::FrameUniforms& frame) {
+        upload(frame_ubo, GL_UNIFORM_BUFFER, &frame, sizeof(frame), frame_capacity);
+        upload(light_ssbo, GL_SHADER_STORAGE_BUFFER, data.point_lights.data(),
+               data.point_lights.size() * sizeof(shader::PointLightGpu), light_capacity);
+        upload(surface_ssbo, GL_SHADER_STORAGE_BUFFER, data.surfaces.data(),
+               data.surfaces.size() * sizeof(shader::SurfaceGpu), surface_capacity);
+        upload(bvh_ssbo, GL_SHADER_STORAGE_BUFFER, data.bvh_nodes.data(),
+               data.bvh_nodes.size() * sizeof(shader::BvhNodeGpu), bvh_capacity);
+        glBindBufferBase(GL_UNIFORM_BUFFER, shader::BINDING_FRAME, frame_ubo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_POINT_LIGHTS, light_ssbo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_SURFACES, surface_ssbo);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_BVH_NODES, bvh_ssbo);
+        upload(spot_ssbo, GL_SHADER_STORAGE_BUFFER, data.spot_lights.data(),
+               data.spot_lights.size() * sizeof(shader::SpotLightGpu), spot_capacity);
+        glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_SPOT_LIGHTS, spot_ssbo);
+        // Table slot i on texture unit i (resources.glsl's table_samplers[i]).
+        for (int slot = 0; slot < shader::TABLE_COUNT; ++slot) {
+            const Table2D* table = data.tables[size_t(slot)];
+            if (table != nullptr) glBindTextureUnit(GLuint(slot), texture_for(*table));
+        }
+        prune_table_textures(data);
+        glDisable(GL_DEPTH_TEST);
+        glDisable(GL_BLEND);
+        grid_pass_cut_texels = 0;
+        for (const GridPassJob& job : data.grid_passes) grid_pass_cut_texels += run_grid_pass(data.features, job);
+        // Where the driver cut a texel's loops (the GL loop limit), the grid
+        // passes are computed again on the CPU (the later passes read the
+        // earlier ones) and replace the textures.
+        if (grid_pass_cut_texels == 0) return;
+        CpuBackend cpu;
+        const std::vector<Table2D> tables = cpu.grid_passes(data);
+        for (size_t k = 0; k < data.grid_passes.size(); ++k) {
+            const GridPassJob& job = data.grid_passes[k];
+            glTextureSubImage2D(pass_textures[size_t(job.slot)].texture, 0, 0, 0, job.width, job.height,
+                                job.channels == 4 ? GL_RGBA : GL_RED, GL_FLOAT, tables[k].texels.data());
+        }
+    }
+
+    // Runs `job` (FrameData::grid_passes) into its texture, bound to its table
+    // slot's unit; returns the number of texels whose loops the driver cut.
+    int run_grid_pass(const shader::Features& features, const GridPassJob& job) {
         PassTexture& t = pass_textures[size_t(job.slot)];
         if (t.texture == 0 || t.width != job.width || t.height != job.height || t.channels != job.channels) {
             if (t.texture != 0) glDeleteTextures(1, &t.texture);
+            if (t.finished != 0) glDeleteTextures(1, &t.finished);
             glCreateTextures(GL_TEXTURE_2D, 1, &t.texture);
             glTextureStorage2D(t.texture, 1, job.channels == 4 ? GL_RGBA32F : GL_R32F, job.width, job.height);
             glTextureParameteri(t.texture, GL_TEXTURE_MIN_FILTER, GL_NEAREST);
             glTextureParameteri(t.texture, GL_TEXTURE_MAG_FILTER, GL_NEAREST);
-            t = {t.texture, job.width, job.height, job.channels};
+            glCreateTextures(GL_TEXTURE_2D, 1, &t.finished);
+            glTextureStorage2D(t.finished, 1, GL_R8, job.width, job.height);
+            t = {t.texture, t.finished, job.width, job.height, job.channels};
         }
         if (pass_fbo == 0) glCreateFramebuffers(1, &pass_fbo);
         glNamedFramebufferTexture(pass_fbo, GL_COLOR_ATTACHMENT0, t.texture, 0);
+        glNamedFramebufferTexture(pass_fbo, GL_COLOR_ATTACHMENT1, t.finished, 0);
+        const GLenum attachments[] = {GL_COLOR_ATTACHMENT0, GL_COLOR_ATTACHMENT1};
+        glNamedFramebufferDrawBuffers(pass_fbo, 2, attachments);
         if (glCheckNamedFramebufferStatus(pass_fbo, GL_FRAMEBUFFER) != GL_FRAMEBUFFER_COMPLETE)
             throw std::runtime_error("airlight: a grid pass's float framebuffer is not supported by this GL driver");
         glBindFramebuffer(GL_FRAMEBUFFER, pass_fbo);
@@ -299,6 +359,11 @@ struct GlBackend::State {
         glBindVertexArray(vao);
         glDrawArrays(GL_TRIANGLES, 0, 3);
         glBindTextureUnit(GLuint(job.slot), t.texture);
+        std::vector<std::uint8_t> finished(size_t(job.width) * size_t(job.height));
+        glPixelStorei(GL_PACK_ALIGNMENT, 1);  // rows of bytes, unpadded
+        glGetTextureImage(t.finished, 0, GL_RED, GL_UNSIGNED_BYTE, GLsizei(finished.size()), finished.data());
+        glPixelStorei(GL_PACK_ALIGNMENT, 4);
+        return int(std::count(finished.begin(), finished.end(), std::uint8_t(0)));
     }
 
     void ensure_target(int width, int height) {
@@ -355,8 +420,10 @@ GlBackend::~GlBackend() {
         state_->display_passes.reset();  // deletes the display stage's GL objects while the context is current
         glDeleteFramebuffers(1, &state_->fbo);
         if (state_->pass_fbo != 0) glDeleteFramebuffers(1, &state_->pass_fbo);
-        for (auto& t : state_->pass_textures)
+        for (auto& t : state_->pass_textures) {
             if (t.texture != 0) glDeleteTextures(1, &t.texture);
+            if (t.finished != 0) glDeleteTextures(1, &t.finished);
+        }
         glDeleteVertexArrays(1, &state_->vao);
         GLuint buffers[] = {state_->frame_ubo, state_->light_ssbo, state_->surface_ssbo, state_->bvh_ssbo,
                             state_->spot_ssbo};
@@ -385,30 +452,7 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
     shader::FrameUniforms frame = data.frame;
     frame.loop_guard_iterations = kLoopGuardIterations;
     frame.tile_width = tile_w;  // row length of a tile's render outputs (render.frag)
-    upload(s.frame_ubo, GL_UNIFORM_BUFFER, &frame, sizeof(frame), s.frame_capacity);
-    upload(s.light_ssbo, GL_SHADER_STORAGE_BUFFER, data.point_lights.data(),
-           data.point_lights.size() * sizeof(shader::PointLightGpu), s.light_capacity);
-    upload(s.surface_ssbo, GL_SHADER_STORAGE_BUFFER, data.surfaces.data(),
-           data.surfaces.size() * sizeof(shader::SurfaceGpu), s.surface_capacity);
-    upload(s.bvh_ssbo, GL_SHADER_STORAGE_BUFFER, data.bvh_nodes.data(),
-           data.bvh_nodes.size() * sizeof(shader::BvhNodeGpu), s.bvh_capacity);
-    glBindBufferBase(GL_UNIFORM_BUFFER, shader::BINDING_FRAME, s.frame_ubo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_POINT_LIGHTS, s.light_ssbo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_SURFACES, s.surface_ssbo);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_BVH_NODES, s.bvh_ssbo);
-    upload(s.spot_ssbo, GL_SHADER_STORAGE_BUFFER, data.spot_lights.data(),
-           data.spot_lights.size() * sizeof(shader::SpotLightGpu), s.spot_capacity);
-    glBindBufferBase(GL_SHADER_STORAGE_BUFFER, shader::BINDING_SPOT_LIGHTS, s.spot_ssbo);
-    // Table slot i on texture unit i (resources.glsl's table_samplers[i]).
-    for (int slot = 0; slot < shader::TABLE_COUNT; ++slot) {
-        const Table2D* table = data.tables[size_t(slot)];
-        if (table != nullptr) glBindTextureUnit(GLuint(slot), s.texture_for(*table));
-    }
-    s.prune_table_textures(data);
-    glDisable(GL_DEPTH_TEST);
-    glDisable(GL_BLEND);
-    // The grid passes, in order, each into its slot (read by the passes after it and the shading pass).
-    for (const GridPassJob& job : data.grid_passes) s.run_grid_pass(data.features, job);
+    s.upload_frame(data, frame);
 
     glBindFramebuffer(GL_FRAMEBUFFER, s.fbo);
     glDisable(GL_DEPTH_TEST);
@@ -475,6 +519,28 @@ void GlBackend::render(const FrameData& data, Image& out, std::vector<size_t>* c
     const GLenum err = glGetError();
     if (err != GL_NO_ERROR) throw std::runtime_error("airlight: GL error " + std::to_string(err) + " while rendering");
 }
+
+std::vector<Table2D> GlBackend::grid_passes(const FrameData& data) {
+    State& s = *state_;
+    State::Current current(s);
+    shader::FrameUniforms frame = data.frame;
+    frame.loop_guard_iterations = kLoopGuardIterations;
+    s.upload_frame(data, frame);
+    std::vector<Table2D> tables;
+    for (const GridPassJob& job : data.grid_passes) {
+        Table2D t;
+        t.width = job.width;
+        t.height = job.height;
+        t.channels = job.channels;
+        t.texels.resize(size_t(job.width) * size_t(job.height) * size_t(job.channels));
+        glGetTextureImage(s.pass_textures[size_t(job.slot)].texture, 0, job.channels == 4 ? GL_RGBA : GL_RED, GL_FLOAT,
+                          GLsizei(t.texels.size() * sizeof(float)), t.texels.data());
+        tables.push_back(std::move(t));
+    }
+    return tables;
+}
+
+int GlBackend::grid_pass_cut_texels() const { return state_->grid_pass_cut_texels; }
 
 int GlBackend::max_texture_size() {
     State::Current current(*state_);

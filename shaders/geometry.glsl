@@ -128,7 +128,11 @@ float trace_surfaces_below(vec3 origin, vec3 dir, float t_max, bool any_hit, int
     int stack[BVH_STACK_SIZE];
     int top = 0;
     stack[top++] = 0;
-    while (top > 0) {
+    // A traversal visits each node at most once. The bound is also needed on
+    // GL: llvmpipe can keep a `while (top > 0)` loop running after every lane
+    // has left it, until its loop limiter (docs/architecture.md, "GL loop
+    // limit") ends all of the invocation's loops (seen in grid passes).
+    for (int visits = 0; visits < frame.bvh_node_count && top > 0; ++visits) {
         BvhNodeGpu node = bvh_node(stack[--top]);
         if (!ray_meets_box(origin, inv_dir, vec3(node.lo), vec3(node.hi), best)) continue;
         if (node.info.y == 0) {

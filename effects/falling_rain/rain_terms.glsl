@@ -25,9 +25,8 @@ vec4 rain_surround_pass(int x, int y) {
 // A lamp's or spot's light on the drop at p seen along v (eq. 4.5): its
 // intensity (a spot's times its profile toward p: nothing outside its cone)
 // over the squared distance, no closer than its radius, through the
-// homogeneous medium, times the drop's phase function. Not shadowed by the
-// surfaces: on GL (llvmpipe) the grid pass's shadow rays disagreed with the
-// CPU's where the scene has boxes (physics.md section 6).
+// homogeneous medium, times the drop's phase function; 0 where a surface lies
+// between the drop and the light's sphere (V_j).
 vec3 rain_lamp_light(vec3 p, vec3 v, vec3 position, float radius, vec3 intensity, bool spot, int spot_index) {
     vec3 to_light = position - p;
     float dist = length(to_light);
@@ -35,13 +34,15 @@ vec3 rain_lamp_light(vec3 p, vec3 v, vec3 position, float radius, vec3 intensity
     vec3 l = to_light / dist;
     float profile = spot ? spot_profile_toward(spot_light(spot_index), -l) : 1.0f;
     if (!(profile > 0.0f)) return vec3(0.0f);
+    if (segment_occluded(p, l, dist - radius, -1)) return vec3(0.0f);
     return intensity * (profile / max(dist * dist, radius * radius)) * transmittance(dist) * drop_phase(dot(l, v));
 }
 
 // Grid pass rain_light: drop k = x + RAIN_ROW_TEXELS y's radiance toward the
 // camera at the middle of its streak (eq. 4.5): every lamp's and spot's
-// irradiance (inverse square, the homogeneous medium's attenuation), the sun's (as on a surface facing it: shadows, clouds) through
-// the drop's phase function, and its surroundings (rain_surround).
+// irradiance (inverse square, the homogeneous medium's attenuation, the
+// surfaces' shadows), the sun's (as on a surface facing it: shadows, clouds)
+// through the drop's phase function, and its surroundings (rain_surround).
 vec4 rain_light_pass(int x, int y) {
     int k = x + RAIN_ROW_TEXELS * y;
     if (k >= frame.falling_rain.tiles.z) return vec4(0.0f);

@@ -307,7 +307,8 @@ void find_shadow_runs(vec3 o, vec3 d, float t_end, vec4 light) {
     int stack[BVH_STACK_SIZE];
     int top = 0;
     stack[top++] = 0;
-    while (top > 0) {
+    // Each node at most once; bounded for llvmpipe (geometry.glsl, trace_surfaces_below).
+    for (int visits = 0; visits < frame.bvh_node_count && top > 0; ++visits) {
         BvhNodeGpu node = bvh_node(stack[--top]);
         vec2 node_run = caster_shadow_run(SURFACE_BOX, vec3(node.lo), vec3(node.hi), light, o, d);
         if (!(max(node_run.x, 0.0f) < min(node_run.y, t_end))) continue;

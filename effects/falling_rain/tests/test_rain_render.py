@@ -218,6 +218,34 @@ def test_a_surface_in_front_hides_the_drop_and_one_behind_does_not(renderer):
             np.testing.assert_allclose(energy, clear, rtol=1e-4)
 
 
+def test_a_box_between_the_lamp_and_the_drop_shadows_it_and_one_beside_does_not(renderer):
+    scene, drops, k, _ = lit_scene("far", 60.0)
+    p = drops["position"][k]
+    lamp = np.array(scene["lights"][0]["position"])
+    clear, _ = rendered_energy(renderer, scene)
+    assert np.all(clear > 0)
+    # A 0.2 m cube halfway along the lamp's light, then the same cube moved 0.5 m off that line
+    # (along the camera's up, so it neither crosses the light nor the camera's view of the drop).
+    middle = 0.5 * (p + lamp)
+    up = np.array([0.0, 1.0, 0.0])
+    for offset, shadowed in ((0.0, True), (0.5, False)):
+        centre = middle + offset * up
+        boxed = copy.deepcopy(scene)
+        boxed["surfaces"] = [
+            {
+                "type": "box",
+                "min": (centre - 0.1).tolist(),
+                "max": (centre + 0.1).tolist(),
+                "albedo": [0, 0, 0],
+            }
+        ]
+        energy, _ = rendered_energy(renderer, boxed)
+        if shadowed:
+            assert np.all(energy == 0.0), energy
+        else:
+            np.testing.assert_allclose(energy, clear, rtol=1e-4)
+
+
 TABLES = textwrap.dedent("""
     import json, sys, airlight
     out = airlight.render(json.loads(sys.argv[1]), backend="cpu", outputs=["falling_rain"])
