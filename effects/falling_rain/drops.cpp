@@ -13,11 +13,47 @@
 
 namespace airlight {
 
+namespace {
+
+// Atlas, Srivastava and Sekhon's fit to Gunn and Kinzer (eq. 1.2, D >= 0.51 mm).
+double atlas_speed(double d_mm) { return 9.65 - 10.3 * std::exp(-0.6 * d_mm); }
+
+// A water sphere's terminal speed under the Schiller-Naumann drag law (eq. 1.2,
+// small drops): v (1 + 0.15 Re^0.687) = v_Stokes with Re = rho_a v D / eta,
+// solved by Newton's method from v_Stokes (the left side is convex and
+// increasing in v, so the iterates fall monotonically to the root).
+double schiller_naumann_speed(double d_mm) {
+    constexpr double rho_air = 1.204, eta = 1.813e-5, rho_water = 998.2, g = 9.80665;  // 20 C, 1013 hPa
+    const double d = 1e-3 * d_mm;
+    const double v_stokes = g * d * d * (rho_water - rho_air) / (18.0 * eta);
+    const double a = 0.15 * std::pow(rho_air * d / eta, 0.687);
+    double v = v_stokes;
+    for (int i = 0; i < 60 && v > 0.0; ++i) {
+        const double step = (v + a * std::pow(v, 1.687) - v_stokes) / (1.0 + 1.687 * a * std::pow(v, 0.687));
+        v -= step;
+        if (!(std::abs(step) > 1e-13 * v)) break;
+    }
+    return v;
+}
+
+}  // namespace
+
+double rain_speed_crossing_mm() {
+    // Where the drag law meets the fit, by bisection (the drag law is above the fit below it).
+    static const double crossing = [] {
+        double lo = 0.2, hi = 0.9;
+        for (int i = 0; i < 60; ++i) {
+            const double mid = 0.5 * (lo + hi);
+            (schiller_naumann_speed(mid) > atlas_speed(mid) ? lo : hi) = mid;
+        }
+        return 0.5 * (lo + hi);
+    }();
+    return crossing;
+}
+
 double terminal_speed(double d_mm) {
-    const auto fit = [](double d) { return 9.65 - 10.3 * std::exp(-0.6 * d); };
-    if (d_mm >= RAIN_STOKES_MM) return fit(d_mm);
-    const double x = d_mm / RAIN_STOKES_MM;
-    return fit(RAIN_STOKES_MM) * x * x;
+    if (!(d_mm > 0.0)) return 0.0;
+    return d_mm >= rain_speed_crossing_mm() ? atlas_speed(d_mm) : schiller_naumann_speed(d_mm);
 }
 
 namespace {

@@ -28,11 +28,12 @@ constexpr std::size_t FALLING_RAIN_MAX_SPHERE = std::size_t(1) << 24;
 
 // Marshall-Palmer N(D) = N0 exp(-Lambda D) (eq. 1.1): N0 is MARSHALL_PALMER_N0
 // (effects/daytime/sky.hpp), Lambda marshall_palmer_slope (effects/rainbow/rainbow.hpp).
-// Terminal fall speed (m/s) of a drop of diameter d_mm (eq. 1.2): Atlas et al.'s
-// fit to Gunn and Kinzer, 9.65 - 10.3 exp(-0.6 D), above RAIN_STOKES_MM; below,
-// the fit's value there scaled by (D / RAIN_STOKES_MM)^2 (the Stokes regime).
-constexpr double RAIN_STOKES_MM = 0.25;
+// Terminal fall speed (m/s) of a drop of diameter d_mm (eq. 1.2): a rigid sphere
+// under the Schiller-Naumann drag law in air at 20 C and 1013 hPa below
+// rain_speed_crossing_mm(), Atlas et al.'s fit to Gunn and Kinzer,
+// 9.65 - 10.3 exp(-0.6 D), above it (where the two meet, about 0.51 mm).
 double terminal_speed(double d_mm);
+double rain_speed_crossing_mm();
 // Drops per m^3 with diameters in [lo, hi] mm, and their water (g/m^3), eq. 1.3.
 double rain_number_density(double rate, double lo_mm, double hi_mm);
 double rain_water_content(double rate, double lo_mm, double hi_mm);

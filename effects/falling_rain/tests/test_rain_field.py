@@ -86,18 +86,28 @@ def test_water_content_is_marshall_palmers_classic_value():
         assert abs(full / (0.089 * rate**0.84) - 1) < 0.1
 
 
-def test_fall_speeds_match_the_fit_and_gunn_kinzer():
+def test_fall_speeds_match_the_fit_the_drag_law_and_gunn_kinzer():
     scene, drops = field(25.0, 1.0)
     d = drops["diameter"]
-    fit = np.where(
-        d >= 0.25, 9.65 - 10.3 * np.exp(-0.6 * d), (9.65 - 10.3 * math.exp(-0.15)) * (d / 0.25) ** 2
-    )
-    np.testing.assert_allclose(-drops["velocity"][:, 1], fit, rtol=1e-12)
+    speed = -drops["velocity"][:, 1]
+    # Above the crossing: Atlas et al.'s fit; below it: a sphere's force balance under Schiller-Naumann
+    # drag (root-found here); the drawn drops carry exactly the speed of their diameter.
+    crossing = 0.508
+    large = d > crossing + 1e-3
+    np.testing.assert_allclose(speed[large], 9.65 - 10.3 * np.exp(-0.6 * d[large]), rtol=1e-12)
+    small = d < crossing - 1e-3
+    assert small.sum() > 20
+    for diameter, v in zip(d[small][:50], speed[small][:50]):
+        assert abs(v / ref.sphere_terminal_speed(diameter) - 1) < 1e-9, diameter
     for diameter, measured in ref.GUNN_KINZER.items():
-        assert abs(airlight._core.rain_terminal_speed(diameter) / measured - 1) < 0.04, diameter
-    # Continuous where the Stokes regime meets the fit.
-    below, above = (airlight._core.rain_terminal_speed(0.25 + e) for e in (-1e-9, 1e-9))
-    assert abs(below - above) < 1e-6
+        # 8 % at 0.1 mm, where any smooth-sphere drag law gives 0.25 m/s against the measured 0.27.
+        tolerance = 0.09 if diameter < 0.15 else 0.025
+        assert abs(airlight._core.rain_terminal_speed(diameter) / measured - 1) < tolerance, diameter
+    # Growing with the diameter and continuous where the drag law meets the fit: no step of the
+    # 2.95e-4 mm grid rises by more than the steepest slope (4.7 m/s per mm, at 0.19 mm) allows.
+    grid = np.linspace(0.1, 6.0, 20001)
+    steps = np.diff([airlight._core.rain_terminal_speed(x) for x in grid])
+    assert np.all(steps > 0) and steps.max() < 1.5e-3
 
 
 @pytest.mark.parametrize("wind", [[0, 0, 0], [3.5, 0, -1.0], [50, 0, 0]])
