@@ -10,6 +10,7 @@ vec3 transmittance(float t) {
     if (t >= NO_HIT) {  // explicit: exp(-0 * inf) may be NaN once a compiler reassociates
         return vec3(sigma_t.x > 0.0f ? 0.0f : 1.0f, sigma_t.y > 0.0f ? 0.0f : 1.0f, sigma_t.z > 0.0f ? 0.0f : 1.0f);
     }
+    if (GREY_MEDIUM) return vec3(exp(-sigma_t.x * t));  // the channels are equal: one exp, not three
     return exp(-sigma_t * t);
 }
 
