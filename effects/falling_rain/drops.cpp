@@ -29,7 +29,8 @@ double schiller_naumann_speed(double d_mm) {
     const double a = 0.15 * std::pow(rho_air * d / eta, 0.687);
     double v = v_stokes;
     for (int i = 0; i < 60 && v > 0.0; ++i) {
-        const double step = (v + a * std::pow(v, 1.687) - v_stokes) / (1.0 + 1.687 * a * std::pow(v, 0.687));
+        const double v_0687 = std::pow(v, 0.687);  // one pow per step: v^1.687 = v v^0.687
+        const double step = (v + a * v * v_0687 - v_stokes) / (1.0 + 1.687 * a * v_0687);
         v -= step;
         if (!(std::abs(step) > 1e-13 * v)) break;
     }
