@@ -130,6 +130,13 @@ def test_fall_speeds_match_the_fit_the_drag_law_and_gunn_kinzer():
     grid = np.linspace(0.1, 6.0, 20001)
     steps = np.diff([airlight._core.rain_terminal_speed(x) for x in grid])
     assert np.all(steps > 0) and steps.max() < 1.5e-3
+    # Over a size class (diameters in the ratio 60^(1/24) = 1.186) v grows by at most 1.323, so the
+    # sampler's rejection step v(D) / v(D_k+1) keeps at least 75 % of its candidates (physics.md eq. 3.4).
+    ratio = (ref.D_MAX / ref.D_MIN) ** (1 / 24)
+    low = np.linspace(ref.D_MIN, ref.D_MAX / ratio, 4001)
+    speed = airlight._core.rain_terminal_speed
+    growth = [speed(x * ratio) / speed(x) for x in low]
+    assert max(growth) < 1.324, max(growth)
 
 
 @pytest.mark.parametrize("wind", [[0, 0, 0], [3.5, 0, -1.0], [50, 0, 0]])
