@@ -1,8 +1,8 @@
 """Where a lamp-pixel's time goes: the lamp airlight kernel's cost per lamp and pixel on both
 backends, and (with ``--perf``) the CPU backend's profile by function.
 
-    .venv/bin/python benchmarks/profile_lamp_kernel.py [--width 640 --height 360] [--frames 5]
-        [--perf] [--out docs/profile_lamp_kernel.txt]
+    .venv/bin/python effects/lamp_airlight/bench/profile_lamp_kernel.py [--width 640 --height 360]
+        [--frames 5] [--perf] [--out effects/lamp_airlight/docs/profile_lamp_kernel.txt]
 
 The scene is `foggy_street`'s 16 point lamps in its fog (sigma_t 0.04/m, isotropic, grey) with
 no surfaces, so that every camera ray escapes and each lamp-pixel is one closed-form tail of the
@@ -95,7 +95,8 @@ def main() -> None:
     lines = [
         "# The lamp airlight kernel: time per lamp-pixel",
         "",
-        "`.venv/bin/python benchmarks/profile_lamp_kernel.py" + (" --perf" if args.perf else "")
+        "`.venv/bin/python effects/lamp_airlight/bench/profile_lamp_kernel.py"
+        + (" --perf" if args.perf else "")
         + (f" --out {args.out}" if args.out else "") + "`",
         "",
         f"Machine: {os.cpu_count()} cores, {platform.processor() or platform.machine()}; "
