@@ -57,7 +57,9 @@
 #                      object (a base of Quality, so its fields read
 #                      scene.quality.<field>); its keys EFFECT_QUALITY_KEYS are
 #                      parsed by parse_<name>_quality(const SceneObject&, Scene&)
-#                      and written by write_<name>_quality(const Scene&, json&)
+#                      and written by write_<name>_quality(const Scene&, json&);
+#                      preset_<name>_quality(QualityPreset, Scene&) sets them
+#                      for the key quality.preset before the explicit keys
 #   EFFECT_SCENE_KEYS  top-level scene keys the effect parses and writes back:
 #                      it defines parse_<name>_keys(const SceneObject&, Scene&)
 #                      and write_<name>_keys(const Scene&, nlohmann::json&)

@@ -36,6 +36,7 @@ AIRLIGHT_SCENE_KEY_EFFECTS(AIRLIGHT_X)
 #undef AIRLIGHT_X
 // ... and their keys of the "quality" object (EFFECT_QUALITY_KEYS).
 #define AIRLIGHT_X(e)                                               \
+    void preset_##e##_quality(QualityPreset preset, Scene& s);      \
     void parse_##e##_quality(const SceneObject& quality, Scene& s); \
     void write_##e##_quality(const Scene& s, json& quality);
 AIRLIGHT_QUALITY_KEY_EFFECTS(AIRLIGHT_X)
@@ -54,6 +55,8 @@ const NameTable<PhaseType> phase_types{{"isotropic", PhaseType::isotropic},
 const NameTable<LightType> light_types{{"point", LightType::point}, {"spot", LightType::spot}};
 const NameTable<AirlightMethod> airlight_methods{{"analytic", AirlightMethod::analytic},
                                                  {"march", AirlightMethod::march}};
+const NameTable<QualityPreset> quality_presets{
+    {"fast", QualityPreset::fast}, {"default", QualityPreset::default_}, {"reference", QualityPreset::reference}};
 const NameTable<SurfaceType> surface_types{
     {"plane", SurfaceType::plane}, {"box", SurfaceType::box}, {"sphere", SurfaceType::sphere}};
 
@@ -254,9 +257,23 @@ Surface parse_surface(const SceneObject& o) {
 
 // The "quality" object: the core's keys here, each effect's in its
 // parse_<name>_quality (EFFECT_QUALITY_KEYS).
+// The core's knobs under a preset: culling (effects/lamp_airlight/docs/culling.md
+// bounds its error by cull_fraction per skipped lamp; docs/quality_presets.md
+// measures the time it saves).
+void preset_core_quality(QualityPreset preset, Scene& s) {
+    if (preset == QualityPreset::fast) s.quality.cull_fraction = 1e-4f;
+    if (preset == QualityPreset::reference) s.quality.cull_fraction = 0.0f;
+}
+
 void parse_quality(const SceneObject& o, Scene& s) {
-    o.check_keys({"airlight", "march_steps", "cull_fraction", AIRLIGHT_EFFECT_QUALITY_KEYS});
+    o.check_keys({"preset", "airlight", "march_steps", "cull_fraction", AIRLIGHT_EFFECT_QUALITY_KEYS});
     Quality& q = s.quality;
+    // The preset first, so that every explicit key below overrides it.
+    if (auto v = o.opt("preset")) q.preset = read_enum(*v, "preset", quality_presets);
+    preset_core_quality(q.preset, s);
+#define AIRLIGHT_X(e) preset_##e##_quality(q.preset, s);
+    AIRLIGHT_QUALITY_KEY_EFFECTS(AIRLIGHT_X)
+#undef AIRLIGHT_X
     if (auto v = o.opt("airlight")) q.airlight = read_enum(*v, "airlight", airlight_methods);
     if (auto v = o.opt("march_steps")) q.march_steps = read_int(*v, 1, 65536);
     if (auto v = o.opt("cull_fraction")) {
@@ -362,7 +379,8 @@ json scene_to_json_value(const Scene& s) {
         j["surfaces"].push_back(std::move(o));
     }
     j["background"] = json_vec3(s.background);
-    j["quality"] = {{"airlight", name_of(airlight_methods, s.quality.airlight)},
+    j["quality"] = {{"preset", name_of(quality_presets, s.quality.preset)},
+                    {"airlight", name_of(airlight_methods, s.quality.airlight)},
                     {"march_steps", s.quality.march_steps},
                     {"cull_fraction", json_number(s.quality.cull_fraction)}};
 #define AIRLIGHT_X(e) write_##e##_quality(s, j["quality"]);

@@ -159,6 +159,13 @@ void write_daytime_keys(const Scene& s, json& j) {
 
 namespace airlight {
 
+// The altitude levels under each preset (docs/daytime.md section 3 measures
+// the error against the number of levels; docs/quality_presets.md the time).
+void preset_daytime_quality(QualityPreset preset, Scene& s) {
+    if (preset == QualityPreset::fast) s.quality.sky_segments = 8;
+    if (preset == QualityPreset::reference) s.quality.sky_segments = 64;
+}
+
 // The quality key "sky_segments" (EFFECT_QUALITY_KEYS).
 void parse_daytime_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("sky_segments")) s.quality.sky_segments = read_int(*v, 2, 64);

@@ -11,6 +11,11 @@ const NameTable<ShaftsMethod> shafts_methods{
     {"analytic", ShaftsMethod::analytic}, {"march", ShaftsMethod::march}, {"off", ShaftsMethod::off}};
 }
 
+// Every preset keeps the analytic shafts: they are exact (physics.md) and the
+// cheapest way to get shadows in the air; "off" is a different image, "march"
+// a comparison.
+void preset_light_shafts_quality(QualityPreset, Scene&) {}
+
 void parse_light_shafts_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("shafts")) s.quality.shafts = read_enum(*v, "shafts", shafts_methods);
 }

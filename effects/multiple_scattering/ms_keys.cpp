@@ -5,6 +5,11 @@ namespace airlight {
 
 using namespace scene_keys;
 
+// Every preset keeps multiple scattering on: turning it off is not a saving at
+// a bounded error but a different physics (rainy days 10^5 times too dark,
+// physics.md section 9).
+void preset_multiple_scattering_quality(QualityPreset, Scene&) {}
+
 void parse_multiple_scattering_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("multiple_scattering")) s.quality.multiple_scattering = read_bool(*v);
 }

@@ -144,6 +144,22 @@ void write_noise_clouds_keys(const Scene& s, json& j) {
     }
 }
 
+// The clouds' marches under each preset (physics.md section 4; their error
+// against the step counts: docs/quality_presets.md). "march" stays a
+// comparison, never a preset.
+void preset_noise_clouds_quality(QualityPreset preset, Scene& s) {
+    if (preset == QualityPreset::fast) {
+        s.quality.cloud_steps = 48;
+        s.quality.cloud_light_steps = 16;
+        s.quality.cloud_shadow_steps = 8;
+    }
+    if (preset == QualityPreset::reference) {
+        s.quality.cloud_steps = 192;
+        s.quality.cloud_light_steps = 64;
+        s.quality.cloud_shadow_steps = 32;
+    }
+}
+
 void parse_noise_clouds_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("clouds")) s.quality.clouds = read_enum(*v, "clouds", clouds_methods);
     if (auto v = quality.opt("cloud_steps")) s.quality.cloud_steps = read_int(*v, 4, 4096);

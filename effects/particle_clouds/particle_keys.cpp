@@ -68,6 +68,11 @@ void write_particle_clouds_keys(const Scene& s, json& j) {
     write_cloud_layer(c, j["particle_clouds"]);
 }
 
+// Every preset keeps the full table and the tiles: the preview table is not
+// accurate for thick particles (physics.md section 3), and the tiles give the
+// same image as testing every particle, faster.
+void preset_particle_clouds_quality(QualityPreset, Scene&) {}
+
 void parse_particle_clouds_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("particle_table"))
         s.quality.particle_table = read_enum(*v, "particle_table", table_qualities);

@@ -10,6 +10,12 @@ namespace airlight {
 
 using namespace scene_keys;
 
+// Wavelength nodes under each preset (docs/rainbow.md measures the colour
+// error of fewer): the default is already the finest table.
+void preset_rainbow_quality(QualityPreset preset, Scene& s) {
+    if (preset == QualityPreset::fast) s.quality.rainbow_wavelengths = 9;
+}
+
 void parse_rainbow_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("rainbow_wavelengths")) {
         const int n = read_int(*v, 3, RAINBOW_WAVELENGTHS);

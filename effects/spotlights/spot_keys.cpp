@@ -8,6 +8,13 @@ namespace airlight {
 
 using namespace scene_keys;
 
+// Samples of a spot's glow quadrature under each preset (docs/spot_table.md
+// section 9: 8 about 5e-3, 12 about 8e-4, 16 about 5e-4 relative).
+void preset_spotlights_quality(QualityPreset preset, Scene& s) {
+    if (preset == QualityPreset::fast) s.quality.spot_glow_samples = 8;
+    if (preset == QualityPreset::reference) s.quality.spot_glow_samples = 32;
+}
+
 void parse_spotlights_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("spot_glow_samples")) {
         s.quality.spot_glow_samples = read_int(*v, 4, 64);

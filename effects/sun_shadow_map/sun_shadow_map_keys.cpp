@@ -9,6 +9,10 @@ namespace airlight {
 
 using namespace scene_keys;
 
+// Every preset keeps exact shadow rays: the map is no faster on these scenes
+// and adds error (physics.md; its benchmark).
+void preset_sun_shadow_map_quality(QualityPreset, Scene&) {}
+
 void parse_sun_shadow_map_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("sun_shadow_map")) {
         const int n = read_int(*v, 0, 4096);

@@ -115,10 +115,21 @@ enum class AirlightMethod {
     march,     // brute-force ray marching, for benchmarks and comparison
 };
 
+// A named set of the quality knobs (the key "quality.preset"): each effect
+// maps it onto its own knobs (preset_<name>_quality, next to its keys) before
+// the scene's explicit quality keys, which override it. Its values and their
+// measured time and error: docs/quality_presets.md.
+enum class QualityPreset {
+    fast,       // the knobs that save time at a measured error, inside each effect's stated bound
+    default_,   // each knob's default (the struct initialisers below and in the effects)
+    reference,  // every knob at its most accurate setting: the images the accuracy tests compare
+};
+
 // Accuracy and speed settings (the "quality" object of the scene format):
 // the core's here, each effect's in its EFFECT_QUALITY struct, a base of
 // Quality (scene.quality.<field> reads either).
 struct CoreQuality {
+    QualityPreset preset = QualityPreset::default_;
     AirlightMethod airlight = AirlightMethod::analytic;
     int march_steps = 64;  // midpoint-rule steps per light and view ray, for "march"
     // A light is skipped wherever a bound proves its contribution to a pixel

@@ -1,4 +1,5 @@
-"""Checks on rendered images: shape, finiteness, sign, and the GL/CPU disagreement metric.
+"""Checks on rendered images: shape, finiteness, sign, the GL/CPU disagreement metric, and the
+error of an image against a reference image (``error_against_reference``).
 
 The disagreement metric. Both backends run the same GLSL in float32, so they differ by
 rounding, except where a rounding decides a discrete event: a ray that grazes an edge hits
@@ -77,6 +78,16 @@ def _relative(a: np.ndarray, b: np.ndarray, floor: float) -> np.ndarray:
     with np.errstate(invalid="ignore", divide="ignore"):
         e = np.where(num > 0, num / den, 0.0)
     return np.asarray(e.max(axis=2))
+
+
+def error_against_reference(image: np.ndarray, reference: np.ndarray,
+                            floor_fraction: float = FLOOR_FRACTION) -> np.ndarray:
+    """Per pixel, the largest channel of |image - ref| / (ref + floor), floor = ``floor_fraction``
+    x the reference's mean radiance (at least ABSOLUTE_FLOOR): pixels a thousand times darker than
+    the image's average do not count (the quality presets' error, docs/quality_presets.md)."""
+    ref = reference.astype(np.float64)
+    floor = max(floor_fraction * float(ref.mean()), ABSOLUTE_FLOOR)
+    return np.asarray((np.abs(image.astype(np.float64) - ref) / (ref + floor)).max(axis=2))
 
 
 def _neighbour_max(values: np.ndarray) -> np.ndarray:
