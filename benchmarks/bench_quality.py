@@ -52,14 +52,14 @@ from tools.fuzz.compare import error_against_reference  # noqa: E402
 PRESETS = ("fast", "default", "reference")
 
 
-def _street(lights: int, light_type: str) -> dict[str, Any]:
-    """bench_airlight's street with grey surfaces (lit, shadowed, glowing)."""
+def _street(lights: int, light_type: str, surface_albedo: float) -> dict[str, Any]:
+    """bench_airlight's street."""
     path = ROOT / "effects" / "lamp_airlight" / "bench" / "bench_airlight.py"
     spec = importlib.util.spec_from_file_location("bench_airlight", path)
     assert spec is not None and spec.loader is not None
     module = importlib.util.module_from_spec(spec)
     spec.loader.exec_module(module)
-    scene: dict[str, Any] = module.street_scene(lights, 640, 360, surface_albedo=0.3, light_type=light_type)
+    scene: dict[str, Any] = module.street_scene(lights, 640, 360, surface_albedo, light_type)
     return scene
 
 
@@ -74,14 +74,14 @@ CASES: list[tuple[str, str, Any, dict[str, Any] | None]] = [
     ("lamps16", "16 lamps, 26 lit surfaces (foggy_street)", lambda: _preset("foggy_street"), AIRLIGHT_MARCH),
     (
         "lamps64",
-        "64 lamps, 25 lit surfaces (bench_airlight's street)",
-        lambda: _street(64, "point"),
+        "64 lamps, 25 grey surfaces (bench_airlight's street)",
+        lambda: _street(64, "point", 0.3),
         AIRLIGHT_MARCH,
     ),
     (
         "headlights64",
-        "32 cars' headlights (bench_airlight's street)",
-        lambda: _street(64, "headlights"),
+        "32 cars' headlights, black surfaces (bench_airlight's street: the airlight alone)",
+        lambda: _street(64, "headlights", 0.0),
         AIRLIGHT_MARCH,
     ),
     (
@@ -250,6 +250,30 @@ def table(rows: list[Row]) -> str:
     return "\n".join(lines)
 
 
+def summary(rows: list[Row]) -> str:
+    """One line per case, size and backend: the default preset's frame, the others' times over it
+    and every method's 99th-percentile error."""
+    by = {(r.case, r.size, r.backend, r.method): r for r in rows}
+    keys = list(dict.fromkeys((r.case, r.size, r.backend) for r in rows))
+    methods = [*PRESETS, "brute force"]
+    lines = [
+        "| case | size | backend | default ms | time x default: fast / reference / brute | "
+        "p99 error: fast / default / reference / brute |",
+        "|---|---|---|---|---|---|",
+    ]
+    for case, size, backend in keys:
+        got = {m: by.get((case, size, backend, m)) for m in methods}
+        base = got["default"]
+        if base is None:
+            continue
+        ratios = " / ".join(
+            f"{r.frame_s / base.frame_s:.2f}" if r else "-" for m, r in got.items() if m != "default"
+        )
+        errors = " / ".join(f"{r.p99_error:.1e}" if r else "-" for r in got.values())
+        lines.append(f"| {case} | {size} | {backend} | {1e3 * base.frame_s:.0f} | {ratios} | {errors} |")
+    return "\n".join(lines)
+
+
 def plot(rows: list[Row], path: Path) -> None:
     """Frame time against the 99th-percentile error, one panel per case and size."""
     import matplotlib
@@ -308,23 +332,38 @@ def main() -> None:
     parser.add_argument("--out", type=Path, help="also write the report here")
     parser.add_argument("--plot", type=Path, help="write the time-against-error chart here (PNG)")
     parser.add_argument("--json", type=Path, help="write the raw rows here")
+    parser.add_argument(
+        "--from-json",
+        type=Path,
+        nargs="+",
+        default=[],
+        help="render nothing: report the rows of these --json files (runs of other cases) together",
+    )
     args = parser.parse_args()
     if args.frames < 1 or args.brute_frames < 1:
         parser.error("--frames and --brute-frames must be at least 1")
-    rows = run(args)
+    if args.from_json:
+        rows = [Row(**r) for path in args.from_json for r in json.loads(path.read_text())]
+    else:
+        rows = run(args)
     info = airlight.backend_info()
+    if args.from_json:
+        how = "the rows of " + ", ".join(f"`{p}`" for p in args.from_json) + " (their runs' settings)"
+    else:
+        how = (
+            f"frame: median of {args.frames} frames after the first ({args.brute_frames} for the brute "
+            f"force; fewer where they would take over {args.budget:g} s)"
+        )
     header = [
         f"# Time against error per effect (`benchmarks/bench_quality.py {' '.join(_argv_shown(args))}`)",
         "",
         f"Backends: {info}. Error: per pixel, the largest channel of |x - ref| / (ref + 1e-3 x mean(ref)),",
-        "ref the CPU backend at the reference preset; frame: median of "
-        f"{args.frames} frames after the first ({args.brute_frames} for the brute force; "
-        f"fewer where they would take over {args.budget:g} s).",
+        f"ref the CPU backend at the reference preset; {how}.",
         "",
         "Cases: " + "; ".join(f"{n}: {what}" for n, what, *_ in CASES if any(r.case == n for r in rows)),
         "",
     ]
-    report = "\n".join(header) + table(rows) + "\n"
+    report = "\n".join(header) + summary(rows) + "\n\nEvery row:\n\n" + table(rows) + "\n"
     print(report)
     if args.out:
         args.out.write_text(report)
@@ -345,6 +384,8 @@ def _argv_shown(args: argparse.Namespace) -> list[str]:
         "--brute-frames",
         str(args.brute_frames),
     ]
+    if args.from_json:
+        return ["--from-json", *map(str, args.from_json)]
     shown += ["--budget", str(args.budget)]
     shown += ["--only", *args.only] if args.only else []
     return shown + (["--skip", *args.skip] if args.skip else [])

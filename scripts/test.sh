@@ -14,7 +14,7 @@ ruff check python tests benchmarks examples effects tools conftest.py
 mypy python/airlight
 clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp effects/*/*.cpp effects/*/*.hpp effects/*/tests/*.cpp
 if [ "${1:-}" = "--quick" ]; then
-    python -m pytest -q -m "not slow"
+    python -m pytest -q --durations=15 -m "not slow"
 else
-    python -m pytest -q
+    python -m pytest -q --durations=30
 fi
