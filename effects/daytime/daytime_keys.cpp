@@ -159,7 +159,7 @@ void write_daytime_keys(const Scene& s, json& j) {
 
 namespace airlight {
 
-// The altitude levels under each preset (docs/daytime.md section 3 measures
+// The altitude levels under each preset (effects/daytime/docs/daytime.md section 3 measures
 // the error against the number of levels; docs/quality_presets.md the time).
 void preset_daytime_quality(QualityPreset preset, Scene& s) {
     if (preset == QualityPreset::fast) s.quality.sky_segments = 8;

@@ -10,7 +10,7 @@ namespace airlight {
 
 using namespace scene_keys;
 
-// Wavelength nodes under each preset (docs/rainbow.md measures the colour
+// Wavelength nodes under each preset (effects/rainbow/docs/rainbow.md measures the colour
 // error of fewer): the default is already the finest table.
 void preset_rainbow_quality(QualityPreset preset, Scene& s) {
     if (preset == QualityPreset::fast) s.quality.rainbow_wavelengths = 9;

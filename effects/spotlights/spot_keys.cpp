@@ -8,7 +8,7 @@ namespace airlight {
 
 using namespace scene_keys;
 
-// Samples of a spot's glow quadrature under each preset (docs/spot_table.md
+// Samples of a spot's glow quadrature under each preset (effects/spotlights/docs/spot_table.md
 // section 9: 8 about 5e-3, 12 about 8e-4, 16 about 5e-4 relative).
 void preset_spotlights_quality(QualityPreset preset, Scene& s) {
     if (preset == QualityPreset::fast) s.quality.spot_glow_samples = 8;
