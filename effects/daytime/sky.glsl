@@ -139,8 +139,9 @@ vec3 sun_irradiance(vec3 p, vec3 n) {
 // the exact sky-phase integral in place of the seed's effective phase
 // value): Lz F_i(C, d) (sky) + E_sun exp(-C / s_y) p_i(d . s) (sun), per
 // channel; kept apart because they change with C at different rates.
-// With multiple scattering (HAS_MULTIPLE_SCATTERING), a third part: the light
-// scattered at least once before, K_i(y, d) + E_res(y) p_i(d . s)
+// With multiple scattering (HAS_MULTIPLE_SCATTERING), the light scattered at
+// least once before: the diffuse field K_i(y, d) (ms) and the residual beam
+// E_res(y) p_i(d . s), which travels along the sun (residual)
 // (effects/multiple_scattering/ms_field.glsl).
 // medium_sun: the sun's light on the homogeneous medium through its phase
 // function (with HAS_MEDIUM_SUN; effects/light_shafts/physics.md section 3).
@@ -148,6 +149,7 @@ struct SpeciesLight {
     vec3 sky[3];
     vec3 sun[3];
     vec3 ms[3];
+    vec3 residual[3];
     vec3 medium_sun;
 };
 
@@ -195,13 +197,17 @@ SpeciesLight species_light(SkyTableDirection t, MsDirection ms_dir, float y, vec
     out_light.sun[1] = sun * sun_phase.species[SPECIES_AEROSOL];
     out_light.sun[2] = sun * sun_phase.species[SPECIES_RAIN];
     out_light.medium_sun = sun * sun_phase.medium;
-    for (int i = 0; i < 3; ++i) out_light.ms[i] = vec3(0.0f);
+    for (int i = 0; i < 3; ++i) {
+        out_light.ms[i] = vec3(0.0f);
+        out_light.residual[i] = vec3(0.0f);
+    }
     if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
         MsLevel level = ms_level(y);
         vec3 residual = HAS_SUN ? ms_sun_residual(level) : vec3(0.0f);
         for (int i = 0; i < 3; ++i) {
-            if (species_present(i))
-                out_light.ms[i] = ms_phased_radiance(i, ms_dir, level) + residual * sun_phase.species[i];
+            if (!species_present(i)) continue;
+            out_light.ms[i] = ms_phased_radiance(i, ms_dir, level);
+            out_light.residual[i] = residual * sun_phase.species[i];
         }
     }
     return out_light;
@@ -226,10 +232,10 @@ void atmosphere_point(float y, float y_piece, SpeciesLight light, OUT(vec3) sigm
         float rho = piece_density(sp, profile_piece(sp, y_piece), y);
         sigma_t += vec3(sp.sigma_t) * rho;
         if (rainbow_layer_apart(i)) {
-            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.ms[i]);
+            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.ms[i] + light.residual[i]);
             j_rainbow = vec3(sp.sigma_s) * rho * light.sun[i];
         } else {
-            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i] + light.ms[i]);
+            j += vec3(sp.sigma_s) * rho * (light.sky[i] + light.sun[i] + light.ms[i] + light.residual[i]);
         }
     }
 }
@@ -403,24 +409,29 @@ vec3 source_integral_part3(vec3 dtau, vec3 s_a, vec3 s_b, vec3 t0, vec3 t1) {
                 source_integral_part(dtau.z, s_a.z, s_b.z, t0.z, t1.z));
 }
 
+// What atmosphere_light returns: the light scattered toward the camera over a
+// stretch of a view ray, attenuated to the stretch's start (by the
+// homogeneous medium too), part by part, and the stretch's optical depth.
+struct AtmosphereLight {
+    vec3 diffuse;                  // the sky's light and the diffuse field's (multiple scattering), every species
+    vec3 sun[SPECIES_COUNT];       // each species' sunlight over the lit parts, times its phase (sun_phase) and sun_scale
+    vec3 residual[SPECIES_COUNT];  // each species' residual beam times its phase, when kept apart; else in diffuse
+    vec3 medium_sun;               // the homogeneous medium's sunlight over the lit parts, times sun_scale
+    vec3 optical_depth;            // the atmosphere's (not the medium's)
+};
+
 // The sun's light of a lit part [t0, t1] (optical depth from the volume's
 // start, per channel) of a volume: each species' share (sun_a, sun_b: its
-// source functions at the volume's ends) into inscatter or, for the rain kept
-// apart, rainbow; the homogeneous medium's (index SPECIES_COUNT) into
-// medium_sun; `weight`: the transmittance from the camera to the volume.
+// source functions at the volume's ends; index SPECIES_COUNT: the homogeneous
+// medium's) into `light`; `weight`: the transmittance from the stretch's
+// start to the volume.
 void add_sun_part(vec3 weight, vec3 dtau, vec3 t0, vec3 t1, vec3 sun_a[SPECIES_COUNT + 1],
-                  vec3 sun_b[SPECIES_COUNT + 1], INOUT(vec3) inscatter, INOUT(vec3) rainbow,
-                  INOUT(vec3) medium_sun) {
+                  vec3 sun_b[SPECIES_COUNT + 1], INOUT(AtmosphereLight) light) {
     for (int i = 0; i < 3; ++i) {
-        if (!species_present(i)) continue;
-        vec3 part = weight * source_integral_part3(dtau, sun_a[i], sun_b[i], t0, t1);
-        if (rainbow_layer_apart(i)) {
-            rainbow += part;
-        } else {
-            inscatter += part;
-        }
+        if (species_present(i)) light.sun[i] += weight * source_integral_part3(dtau, sun_a[i], sun_b[i], t0, t1);
     }
-    if (HAS_MEDIUM_SUN) medium_sun += weight * source_integral_part3(dtau, sun_a[SPECIES_COUNT], sun_b[SPECIES_COUNT], t0, t1);
+    if (HAS_MEDIUM_SUN)
+        light.medium_sun += weight * source_integral_part3(dtau, sun_a[SPECIES_COUNT], sun_b[SPECIES_COUNT], t0, t1);
 }
 
 // The source function J / sigma (0 where sigma = 0).
@@ -429,12 +440,9 @@ vec3 source_function(vec3 j, vec3 sigma) {
                 sigma.z > 0.0f ? j.z / sigma.z : 0.0f);
 }
 
-// Light scattered into the ray o + s d over [0, s_end] by the atmosphere
-// (`inscatter`, already attenuated on its way to the camera, by the
-// homogeneous medium too; the rain's once-scattered sunlight apart in
-// `rainbow` when the render outputs keep it apart, rainbow_layer_apart) and
-// the atmosphere's transmittance over the ray (`transmittance`; the medium's
-// is applied by the caller). Scattering
+// Light scattered into the ray o + s d over [0, s_end] by the atmosphere, by
+// part (AtmosphereLight: attenuated on its way to o, by the homogeneous
+// medium too), and the atmosphere's optical depth over it. Scattering
 // volumes (effects/daytime/physics.md, seed equations 3 to 6, corrected): the ray
 // is cut where it crosses the altitude levels (which include every profile
 // break), and in each volume each species' sky and sun shares of the source
@@ -447,19 +455,24 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // shadowed runs (`shadowed`: those of shadow_runs, effects/light_shafts/physics.md
 // section 5; false: none), times sun_scale (the clouds' transmittance toward
 // the sun over this part of the ray, effects/noise_clouds/physics.md section 9; 1: none).
-void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
-                           OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
-    inscatter = vec3(0.0f);
-    rainbow = vec3(0.0f);
-    medium_sun = vec3(0.0f);
-    transmittance = vec3(1.0f);
+// sun_phase: each species' phase for the sun's light (sun_phase_along(d); all
+// 1 gives the phase-free integrals of the aerial table, aerial_table.glsl);
+// residual_apart: the residual beam in `residual` rather than in `diffuse`.
+AtmosphereLight atmosphere_light(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
+                                 SunPhase sun_phase, bool residual_apart) {
+    AtmosphereLight light;
+    light.diffuse = vec3(0.0f);
+    for (int i = 0; i < SPECIES_COUNT; ++i) {
+        light.sun[i] = vec3(0.0f);
+        light.residual[i] = vec3(0.0f);
+    }
+    light.medium_sun = vec3(0.0f);
+    light.optical_depth = vec3(0.0f);
     float s_in;
     float s_out;
-    if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return;
+    if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return light;
     SkyTableDirection t = sky_table_direction(d);
     MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
-    SunPhase sun_phase = no_sun_phase();
-    if (HAS_SUN) sun_phase = sun_phase_along(d);
     int run_index = 0;  // the first shadowed run that may reach the volume
     int run_count = shadowed ? shadow_runs.count : 0;
     float mu = d.y;
@@ -510,15 +523,25 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
             int piece = profile_piece(sp, y_piece);
             vec3 scale_a = vec3(sp.sigma_s) * piece_density(sp, piece, y_a);
             vec3 scale_b = vec3(sp.sigma_s) * piece_density(sp, piece, y_b);
-            inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.sky[i], sigma_a),
-                                                   source_function(scale_b * light_b.sky[i], sigma_b));
+            light.diffuse += weight * source_integral3(dtau, source_function(scale_a * light_a.sky[i], sigma_a),
+                                                       source_function(scale_b * light_b.sky[i], sigma_b));
             if (HAS_SUN) {
                 sun_a[i] = source_function(scale_a * light_a.sun[i], sigma_a);
                 sun_b[i] = source_function(scale_b * light_b.sun[i], sigma_b);
             }
             if (HAS_MULTIPLE_SCATTERING && frame.multiple_scattering.air_scattering != 0.0f) {
-                inscatter += weight * source_integral3(dtau, source_function(scale_a * light_a.ms[i], sigma_a),
-                                                       source_function(scale_b * light_b.ms[i], sigma_b));
+                if (residual_apart) {
+                    light.diffuse += weight * source_integral3(dtau, source_function(scale_a * light_a.ms[i], sigma_a),
+                                                               source_function(scale_b * light_b.ms[i], sigma_b));
+                    light.residual[i] +=
+                        weight * source_integral3(dtau, source_function(scale_a * light_a.residual[i], sigma_a),
+                                                  source_function(scale_b * light_b.residual[i], sigma_b));
+                } else {
+                    vec3 ms_a = light_a.ms[i] + light_a.residual[i];
+                    vec3 ms_b = light_b.ms[i] + light_b.residual[i];
+                    light.diffuse += weight * source_integral3(dtau, source_function(scale_a * ms_a, sigma_a),
+                                                               source_function(scale_b * ms_b, sigma_b));
+                }
             }
         }
         if (HAS_MEDIUM_SUN) {
@@ -534,8 +557,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
                 vec2 run = shadow_runs.run[run_index];
                 if (run.x > lit_from) {
                     vec3 tau_to = stretch_optical_depth(y_a, y_piece, mu, run.x - s_a) + sigma_medium * (run.x - s_a);
-                    add_sun_part(weight * sun_scale, dtau, tau_from, tau_to, sun_a, sun_b, inscatter, rainbow,
-                                 medium_sun);
+                    add_sun_part(weight * sun_scale, dtau, tau_from, tau_to, sun_a, sun_b, light);
                 }
                 if (run.y >= s_b) {  // shadowed to the volume's end: the run may reach the next volume
                     lit_from = s_b;
@@ -548,14 +570,37 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
                 ++run_index;
             }
             if (lit_from < s_b)
-                add_sun_part(weight * sun_scale, dtau, tau_from, dtau, sun_a, sun_b, inscatter, rainbow, medium_sun);
+                add_sun_part(weight * sun_scale, dtau, tau_from, dtau, sun_a, sun_b, light);
         }
         weight *= exp(-dtau);
-        transmittance *= exp(-tau);
+        light.optical_depth += tau;
         s_a = s_b;
         y_a = y_b;
         light_a = light_b;
     }
+    return light;
+}
+
+// The same summed as the view ray's terms want them: `inscatter` (the rain's
+// once-scattered sunlight apart in `rainbow` when the render outputs keep it
+// apart, rainbow_layer_apart), the medium's sunlight and the atmosphere's
+// transmittance (the medium's is applied by the caller).
+void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
+                           OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
+    SunPhase sun_phase = no_sun_phase();
+    if (HAS_SUN) sun_phase = sun_phase_along(d);
+    AtmosphereLight light = atmosphere_light(o, d, s_end, sigma_medium, shadowed, sun_scale, sun_phase, false);
+    inscatter = light.diffuse;
+    rainbow = vec3(0.0f);
+    for (int i = 0; i < SPECIES_COUNT; ++i) {
+        if (rainbow_layer_apart(i)) {
+            rainbow += light.sun[i];
+        } else {
+            inscatter += light.sun[i];
+        }
+    }
+    medium_sun = light.medium_sun;
+    transmittance = exp(-light.optical_depth);
 }
 
 // The atmosphere's transmittance along o + s d over [0, s_end] (1 without
