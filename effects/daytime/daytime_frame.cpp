@@ -2,12 +2,41 @@
 // atmosphere's species and altitude levels, the switches and the sky-phase
 // table where the scene needs it.
 #include <algorithm>
+#include <glm/glm.hpp>
 #include <vector>
 
 #include "frame_data.hpp"
 #include "sky.hpp"
 
 namespace airlight {
+
+// The aerial table's size and grid passes (aerial_table.glsl), when the
+// scene asks for it and has an atmosphere that is not marched.
+static void pack_aerial_table(const Scene& scene, FrameData& data) {
+    const int nodes = scene.quality.aerial_table;
+    // Clouds walk the volumes over their stretches (effects/daytime/docs/aerial_table.md section 4).
+    if (nodes <= 0 || !data.features.atmosphere || data.features.sky_march || clouds_visible(scene.clouds) ||
+        particle_clouds_visible(scene.particle_clouds))
+        return;
+    shader::FrameUniforms& f = data.frame;
+    const int rows = 4 * nodes + 1;  // odd: the horizon is a row
+    // The diffuse light depends on the azimuth from the sun with a sun (its
+    // multiple scattering) or a sky with an indicatrix.
+    const bool azimuth = data.features.sun || f.atmosphere.sky_table_azimuth_blocks > 1.0f;
+    // (rows x azimuths rows of texels: within GL's 16384)
+    const int azimuths = azimuth ? std::min(nodes, shader::AERIAL_MAX_TEXTURE_ROWS / rows) : 1;
+    glm::vec2 toward(f.sky.sun_direction.x, f.sky.sun_direction.z);
+    const float length = glm::length(toward);
+    toward = length > 1e-6f ? toward / length : glm::vec2(1.0f, 0.0f);
+    f.aerial.size = glm::vec4(float(rows), float(azimuths), float(nodes), 0.0f);
+    f.aerial.sun_axes = glm::vec4(toward.x, toward.y, -toward.y, toward.x);
+    data.features.aerial_table = true;
+    const int parts_width = shader::AERIAL_GROUPS * nodes;
+    data.grid_passes.push_back({shader::TABLE_AERIAL_SEGMENTS, parts_width, rows, 4});
+    data.grid_passes.push_back({shader::TABLE_AERIAL_DIFFUSE_SEGMENTS, nodes, rows * azimuths, 4});
+    data.grid_passes.push_back({shader::TABLE_AERIAL, parts_width, rows, 4});
+    data.grid_passes.push_back({shader::TABLE_AERIAL_DIFFUSE, nodes, rows * azimuths, 4});
+}
 
 void pack_daytime_frame(const Scene& scene, FrameData& data) {
     shader::FrameUniforms& f = data.frame;
@@ -38,6 +67,7 @@ void pack_daytime_frame(const Scene& scene, FrameData& data) {
     f.atmosphere.level_count = float(std::min(levels.size(), size_t(shader::ATMOSPHERE_MAX_LEVELS)));
     f.atmosphere.sky_table_columns = sky_table ? float(sky_table->width) : 1.0f;
     f.atmosphere.sky_table_azimuth_blocks = sky_table ? float(sky_table->height / shader::SKY_TABLE_N_ELEVATION) : 1.0f;
+    pack_aerial_table(scene, data);
 }
 
 }  // namespace airlight

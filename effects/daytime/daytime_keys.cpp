@@ -161,16 +161,29 @@ namespace airlight {
 
 // The altitude levels under each preset (effects/daytime/docs/daytime.md section 3 measures
 // the error against the number of levels; docs/quality_presets.md the time).
+// The reference walks the volumes in every pixel (no aerial table).
 void preset_daytime_quality(QualityPreset preset, Scene& s) {
     if (preset == QualityPreset::fast) s.quality.sky_segments = 8;
-    if (preset == QualityPreset::reference) s.quality.sky_segments = 64;
+    if (preset == QualityPreset::reference) {
+        s.quality.sky_segments = 64;
+        s.quality.aerial_table = 0;
+    }
 }
 
-// The quality key "sky_segments" (EFFECT_QUALITY_KEYS).
+// The quality keys "sky_segments" and "aerial_table" (EFFECT_QUALITY_KEYS).
 void parse_daytime_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("sky_segments")) s.quality.sky_segments = read_int(*v, 2, 64);
+    if (auto v = quality.opt("aerial_table")) {
+        s.quality.aerial_table = read_int(*v, 0, 64);
+        if (s.quality.aerial_table != 0 && s.quality.aerial_table < 8)
+            throw SceneError(SceneError::Kind::value, "quality.aerial_table",
+                             "0 (off) or 8 to 64 distance nodes, got " + std::to_string(s.quality.aerial_table));
+    }
 }
 
-void write_daytime_quality(const Scene& s, json& quality) { quality["sky_segments"] = s.quality.sky_segments; }
+void write_daytime_quality(const Scene& s, json& quality) {
+    quality["sky_segments"] = s.quality.sky_segments;
+    quality["aerial_table"] = s.quality.aerial_table;
+}
 
 }  // namespace airlight

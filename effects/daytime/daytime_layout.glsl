@@ -64,3 +64,21 @@ struct AtmosphereGpu {
     float sky_table_azimuth_blocks;  // its blocks of rows by azimuth (1: no sun)
     vec4 levels[ATMOSPHERE_MAX_LEVELS / 4];  // sorted level altitudes, 4 per vec4 (sky.glsl)
 };
+
+// The aerial table (aerial_table.glsl; effects/daytime/docs/aerial_table.md):
+// distance nodes from AERIAL_NEAR expm1(0) = 0 to AERIAL_FAR (m), log-spaced, and the whole ray.
+CONST float AERIAL_NEAR = 1.0f;
+CONST float AERIAL_FAR = 1.0e6f;
+// The parts of the aerial table's texels: optical depth, then each species'
+// sunlight, the medium's sunlight, each species' residual beam (column
+// group g holds nodes g N .. g N + N - 1).
+CONST int AERIAL_OPTICAL_DEPTH = 0;
+CONST int AERIAL_SUN = 1;       // + species
+CONST int AERIAL_MEDIUM_SUN = 4;
+CONST int AERIAL_RESIDUAL = 5;  // + species
+CONST int AERIAL_GROUPS = 8;
+CONST int AERIAL_MAX_TEXTURE_ROWS = 16384;  // the diffuse table's rows x azimuth blocks, at most
+struct AerialGpu {
+    vec4 size;      // x: elevation rows, y: azimuth blocks, z: distance nodes (the last: the whole ray)
+    vec4 sun_axes;  // xy: horizontal unit vector (x, z) toward the sun's azimuth, zw: the one across
+};

@@ -91,6 +91,12 @@ struct DaytimeQuality {
     // the number of altitude levels that split view rays through the
     // atmosphere (effects/daytime/docs/daytime.md measures error against it), in [2, 64].
     int sky_segments = 16;
+    // The aerial table (effects/daytime/docs/aerial_table.md): 0 walks the
+    // scattering volumes in every pixel; N in [8, 64] tabulates the light
+    // along camera rays once per frame at N distance nodes (4N + 1 elevation
+    // rows, N azimuth blocks where the light depends on the azimuth) and
+    // interpolates it per pixel.
+    int aerial_table = 0;
 };
 
 }  // namespace airlight

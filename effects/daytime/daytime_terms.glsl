@@ -58,8 +58,14 @@ vec3 atmosphere_segment_transfer(vec3 origin, vec3 dir, float a, float b, vec3 r
     } else {
         // The sun's shadows along the ray (effects/light_shafts): counted by the volumes.
         sun_shadow_runs(start, dir, length_);
-        atmosphere_scattering(start, dir, length_, sigma_medium, true, sun_scale, inscatter, rainbow, medium_sun,
-                              through_atmosphere);
+        // The camera's rays look the light up in the aerial table (aerial_table.glsl);
+        // not the clouds' stretches (effects/daytime/docs/aerial_table.md, section 4).
+        bool looked_up = HAS_AERIAL_TABLE && !HAS_CLOUDS && !HAS_PARTICLE_CLOUDS && origin == vec3(frame.camera_position) &&
+                         aerial_scattering(dir, a, b, sun_scale, true, inscatter, rainbow, medium_sun,
+                                           through_atmosphere);
+        if (!looked_up)
+            atmosphere_scattering(start, dir, length_, sigma_medium, true, sun_scale, inscatter, rainbow, medium_sun,
+                                  through_atmosphere);
     }
     if (a > 0.0f) {
         vec3 before = exp(-sigma_medium * a);

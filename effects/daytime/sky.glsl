@@ -458,8 +458,11 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // sun_phase: each species' phase for the sun's light (sun_phase_along(d); all
 // 1 gives the phase-free integrals of the aerial table, aerial_table.glsl);
 // residual_apart: the residual beam in `residual` rather than in `diffuse`.
+// light_direction: the direction whose sky and diffuse light the volumes
+// scatter (d; another only for the aerial table's rays continued past the
+// ground, aerial_table.glsl).
 AtmosphereLight atmosphere_light(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
-                                 SunPhase sun_phase, bool residual_apart) {
+                                 SunPhase sun_phase, bool residual_apart, vec3 light_direction) {
     AtmosphereLight light;
     light.diffuse = vec3(0.0f);
     for (int i = 0; i < SPECIES_COUNT; ++i) {
@@ -471,8 +474,8 @@ AtmosphereLight atmosphere_light(vec3 o, vec3 d, float s_end, vec3 sigma_medium,
     float s_in;
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return light;
-    SkyTableDirection t = sky_table_direction(d);
-    MsDirection ms_dir = ms_view_direction(d);  // (cheap; unused without multiple scattering)
+    SkyTableDirection t = sky_table_direction(light_direction);
+    MsDirection ms_dir = ms_view_direction(light_direction);  // (cheap; unused without multiple scattering)
     int run_index = 0;  // the first shadowed run that may reach the volume
     int run_count = shadowed ? shadow_runs.count : 0;
     float mu = d.y;
@@ -589,7 +592,7 @@ void atmosphere_scattering(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool 
                            OUT(vec3) inscatter, OUT(vec3) rainbow, OUT(vec3) medium_sun, OUT(vec3) transmittance) {
     SunPhase sun_phase = no_sun_phase();
     if (HAS_SUN) sun_phase = sun_phase_along(d);
-    AtmosphereLight light = atmosphere_light(o, d, s_end, sigma_medium, shadowed, sun_scale, sun_phase, false);
+    AtmosphereLight light = atmosphere_light(o, d, s_end, sigma_medium, shadowed, sun_scale, sun_phase, false, d);
     inscatter = light.diffuse;
     rainbow = vec3(0.0f);
     for (int i = 0; i < SPECIES_COUNT; ++i) {
