@@ -208,14 +208,7 @@ AtmosphereLight aerial_light(vec3 d, float s) {
             medium_k1 = vec3(frame.sigma_t) * s_k1;
         }
     }
-    AtmosphereLight light;
-    light.diffuse = vec3(0.0f);
-    for (int i = 0; i < SPECIES_COUNT; ++i) {
-        light.sun[i] = vec3(0.0f);
-        light.residual[i] = vec3(0.0f);
-    }
-    light.medium_sun = vec3(0.0f);
-    light.optical_depth = vec3(0.0f);
+    AtmosphereLight light = no_atmosphere_light();
     bool residual = HAS_MULTIPLE_SCATTERING && HAS_SUN && frame.multiple_scattering.air_scattering != 0.0f;
     for (int corner = 0; corner < 2; ++corner) {
         int row = r0 + corner;

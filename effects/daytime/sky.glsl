@@ -420,6 +420,19 @@ struct AtmosphereLight {
     vec3 optical_depth;            // the atmosphere's (not the medium's)
 };
 
+// No light and no optical depth: a stretch outside the atmosphere.
+AtmosphereLight no_atmosphere_light() {
+    AtmosphereLight light;
+    light.diffuse = vec3(0.0f);
+    for (int i = 0; i < SPECIES_COUNT; ++i) {
+        light.sun[i] = vec3(0.0f);
+        light.residual[i] = vec3(0.0f);
+    }
+    light.medium_sun = vec3(0.0f);
+    light.optical_depth = vec3(0.0f);
+    return light;
+}
+
 // The sun's light of a lit part [t0, t1] (optical depth from the volume's
 // start, per channel) of a volume: each species' share (sun_a, sun_b: its
 // source functions at the volume's ends; index SPECIES_COUNT: the homogeneous
@@ -463,14 +476,7 @@ vec3 source_function(vec3 j, vec3 sigma) {
 // ground, aerial_table.glsl).
 AtmosphereLight atmosphere_light(vec3 o, vec3 d, float s_end, vec3 sigma_medium, bool shadowed, float sun_scale,
                                  SunPhase sun_phase, bool residual_apart, vec3 light_direction) {
-    AtmosphereLight light;
-    light.diffuse = vec3(0.0f);
-    for (int i = 0; i < SPECIES_COUNT; ++i) {
-        light.sun[i] = vec3(0.0f);
-        light.residual[i] = vec3(0.0f);
-    }
-    light.medium_sun = vec3(0.0f);
-    light.optical_depth = vec3(0.0f);
+    AtmosphereLight light = no_atmosphere_light();
     float s_in;
     float s_out;
     if (!atmosphere_interval(o, d, s_end, s_in, s_out)) return light;
