@@ -16,7 +16,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
-from daytime_scenes import relative_error
+from daytime_scenes import OVERCAST, atmosphere, cie_sky, day_scene, relative_error, sun
+from hypothesis import HealthCheck, example, given, settings
+from hypothesis import strategies as st
 from image_checks import finite_non_negative
 from test_daytime_render import CASES, KNOWN_FAILURES, REL_TOL, case_scene, expected_column
 
@@ -128,3 +130,71 @@ def test_aerial_table_key_is_validated_and_written_back():
     assert airlight.load_scene(scene)["quality"]["aerial_table"] == 24
     scene["quality"] = {"preset": "reference", "aerial_table": 24}
     assert airlight.load_scene(scene)["quality"]["aerial_table"] == 24
+
+
+@pytest.mark.slow
+@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(
+    nodes=st.integers(8, 64),
+    rain=st.floats(0.0, 100.0),
+    visibility=st.floats(50.0, 50000.0),
+    scale_height=st.floats(50.0, 2000.0),
+    camera_y=st.floats(0.0, 10000.0),
+    pitch=st.floats(-90.0, 90.0),
+    sky_type=st.integers(0, 15),
+    sun_elevation=st.floats(-30.0, 90.0),
+    ground=st.booleans(),
+    multiple_scattering=st.booleans(),
+)
+@example(
+    nodes=8,
+    rain=100.0,
+    visibility=50.0,
+    scale_height=50.0,
+    camera_y=0.0,
+    pitch=0.0,
+    sky_type=12,
+    sun_elevation=90.0,
+    ground=True,
+    multiple_scattering=True,
+)
+@example(
+    nodes=64,
+    rain=0.0,
+    visibility=50000.0,
+    scale_height=2000.0,
+    camera_y=10000.0,
+    pitch=-90.0,
+    sky_type=13,
+    sun_elevation=0.0,
+    ground=False,
+    multiple_scattering=False,
+)
+def test_random_scenes_through_the_table_are_finite_and_non_negative(
+    renderer,
+    nodes,
+    rain,
+    visibility,
+    scale_height,
+    camera_y,
+    pitch,
+    sky_type,
+    sun_elevation,
+    ground,
+    multiple_scattering,
+):
+    """Random weather, camera, view, sun (at the zenith and below the horizon included) and table
+    size, 4 x 4 pixels: no NaN, no Inf, no negative radiance."""
+    sky = OVERCAST if sky_type == 0 else cie_sky(sky_type)
+    scene = day_scene(
+        sky=sky,
+        sun=sun(sun_elevation, 30.0),
+        atmosphere=atmosphere(visibility=visibility, rain=rain, scale_height=scale_height),
+        camera_y=camera_y,
+        pitch=pitch,
+        width=4,
+        height=4,
+        ground=0.4 if ground else None,
+        multiple_scattering=multiple_scattering,
+    )
+    finite_non_negative(renderer.render(with_table(scene, nodes)), "random daytime scene, aerial table")
