@@ -25,27 +25,48 @@ bool cloud_shadow_free(vec3 origin, vec3 dir, float a, float b) {
 // growing geometrically from a (the last CLOUD_LIGHT_GROWTH times the first;
 // equal with CLOUDS_MARCH), each lit through the clouds' transmittance toward
 // the sun at its middle; beyond CLOUD_VIEW_FAR from a, lit as there. Composed
-// from the far piece to the near one.
+// from the far piece to the near one. One loop with one call of each
+// transfer, so that the shader compiler inlines the atmosphere's walk once.
 vec3 cloud_shadowed_media_transfer(vec3 origin, vec3 dir, float a, float b, vec3 radiance) {
     int pieces = int(frame.clouds.lighting.w);
-    if (pieces == 0 || !HAS_SUN || !(b > a) || cloud_shadow_free(origin, dir, a, b))
-        return media_segment_transfer(origin, dir, a, b, radiance, 1.0f);
+    bool unshadowed = pieces == 0 || !HAS_SUN || !(b > a) || cloud_shadow_free(origin, dir, a, b);
     vec3 s = vec3(frame.sky.sun_direction);
     float far = min(b, a + CLOUD_VIEW_FAR);
-    if (b > far)
-        radiance = media_segment_transfer(origin, dir, far, b, radiance, cloud_transmittance_from(origin + far * dir, s));
+    bool beyond_far = !unshadowed && b > far;  // [far, b] first, lit as at far
     // Piece k spans the sums of r^i over i < k and i <= k, over their total, of [a, far].
     float r = CLOUDS_MARCH || pieces < 2 ? 1.0f : pow(CLOUD_LIGHT_GROWTH, 1.0f / float(pieces - 1));
     float total = r == 1.0f ? float(pieces) : (pow(r, float(pieces)) - 1.0f) / (r - 1.0f);
+    int count = unshadowed ? 1 : pieces + (beyond_far ? 1 : 0);
     float t_end = far;
-    for (int k = pieces - 1; k >= 0; --k) {
-        float before = r == 1.0f ? float(k) : (pow(r, float(k)) - 1.0f) / (r - 1.0f);
-        float t_start = k == 0 ? a : a + (far - a) * (before / total);
-        float lit = cloud_transmittance_from(origin + (0.5f * (t_start + t_end)) * dir, s);
+    for (int i = 0; i < count; ++i) {
+        float t_start = a;
+        float lit = 1.0f;
+        if (unshadowed) {
+            t_end = b;
+        } else if (beyond_far && i == 0) {
+            t_start = far;
+            t_end = b;
+        } else {
+            int k = pieces - 1 - (i - (beyond_far ? 1 : 0));
+            if (k == pieces - 1) t_end = far;
+            float before = r == 1.0f ? float(k) : (pow(r, float(k)) - 1.0f) / (r - 1.0f);
+            if (k > 0) t_start = a + (far - a) * (before / total);
+        }
+        if (!unshadowed) {
+            float lit_at = beyond_far && i == 0 ? far : 0.5f * (t_start + t_end);
+            lit = cloud_transmittance_from(origin + lit_at * dir, s);
+        }
         radiance = media_segment_transfer(origin, dir, t_start, t_end, radiance, lit);
         t_end = t_start;
     }
     return radiance;
+}
+
+// The ends of the view ray's stretches outside the clouds, far to near
+// (physics.md section 5): end i and end i + 1 bound stretch i ([t1, t_hit],
+// [t_half, t1], [t0, t_half], [0, t0]).
+float cloud_stretch_end(int i, float t_hit, float t1, float t_half, float t0) {
+    return i == 0 ? t_hit : i == 1 ? t1 : i == 2 ? t_half : i == 3 ? t0 : 0.0f;
 }
 
 // Hook view_transfer: with clouds, the media along [0, t_hit] composed around
@@ -58,19 +79,24 @@ vec3 cloud_shadowed_media_transfer(vec3 origin, vec3 dir, float a, float b, vec3
 // attenuates the clouds' light from the camera on.
 vec3 clouds_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_CLOUDS) return radiance;
-    float t0;
-    float t1;
-    if (!cloud_layer_interval(origin, dir, t_hit, t0, t1))
-        return cloud_shadowed_media_transfer(origin, dir, 0.0f, t_hit, radiance);
-    vec3 light;
-    float through_clouds;
-    float t_half;
-    cloud_march(origin, dir, t0, t1, light, through_clouds, t_half);
-    radiance = cloud_shadowed_media_transfer(origin, dir, t1, t_hit, radiance);
-    radiance = cloud_shadowed_media_transfer(origin, dir, t_half, t1, radiance);
-    outputs_attenuate(vec3(through_clouds));
-    layer_add(LAYER_CLOUDS, light);
-    radiance = radiance * through_clouds + light;
-    radiance = cloud_shadowed_media_transfer(origin, dir, t0, t_half, radiance);
-    return cloud_shadowed_media_transfer(origin, dir, 0.0f, t0, radiance);
+    float t0 = 0.0f;
+    float t1 = 0.0f;
+    vec3 light = vec3(0.0f);
+    float through_clouds = 1.0f;
+    float t_half = 0.0f;
+    bool through_layer = cloud_layer_interval(origin, dir, t_hit, t0, t1);
+    if (through_layer) cloud_march(origin, dir, t0, t1, light, through_clouds, t_half);
+    else t0 = t1 = t_half = 0.0f;  // one stretch, [0, t_hit]
+    int stretches = through_layer ? 4 : 1;
+    for (int i = 0; i < stretches; ++i) {
+        if (i == 2) {
+            outputs_attenuate(vec3(through_clouds));
+            layer_add(LAYER_CLOUDS, light);
+            radiance = radiance * through_clouds + light;
+        }
+        float b = cloud_stretch_end(i, t_hit, t1, t_half, t0);
+        float a = cloud_stretch_end(i + 1, t_hit, t1, t_half, t0);
+        radiance = cloud_shadowed_media_transfer(origin, dir, a, b, radiance);
+    }
+    return radiance;
 }
