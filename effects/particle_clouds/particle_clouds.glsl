@@ -79,10 +79,16 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
     int m = particle_node(log(max(tau, 1.0e-30f) / taus.x) / taus.y * float(shape.w - 1), shape.w, ft);
     bool below = m > 0;
     bool above = m + 2 < shape.w;
-    vec4 v0 = particle_slice(m, node, f);
-    vec4 v1 = particle_slice(m + 1, node, f);
-    vec4 vm = below ? particle_slice(m - 1, node, f) : vec4(0.0f);
-    vec4 v2 = above ? particle_slice(m + 2, node, f) : vec4(0.0f);
+    // Slices m - 1 (where below) to m + 2 (where above), in one loop with one
+    // call so that the shader compiler emits the slice's texel reads once.
+    vec4 slices[4];
+    slices[0] = vec4(0.0f);
+    slices[3] = vec4(0.0f);
+    for (int j = below ? 0 : 1; j < (above ? 4 : 3); ++j) slices[j] = particle_slice(m - 1 + j, node, f);
+    vec4 vm = slices[0];
+    vec4 v0 = slices[1];
+    vec4 v1 = slices[2];
+    vec4 v2 = slices[3];
     // The channels: order 1 over its phase, orders 2 and 3's peaks over theirs, the rest (eq. 3.1).
     float g = taus.z;
     float mu = dot(s, v);
