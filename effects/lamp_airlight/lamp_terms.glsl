@@ -96,16 +96,18 @@ vec3 point_light_airlight(PointLightGpu light, vec3 origin, vec3 dir, float x_en
     bool shadowed = HAS_LAMP_SHADOWS && light.intensity.w != 0.0f;
     if (AIRLIGHT_MARCH)
         return airlight_march(vec3(light.position_radius), vec3(light.intensity), -1, shadowed, origin, dir, x0, x_end);
-    if (!shadowed) return point_light_segment(scale, b, h, x0, x_end);
-    find_shadow_runs(origin, dir, x_end, vec4(vec3(light.position_radius), 1.0f));
+    if (shadowed) find_shadow_runs(origin, dir, x_end, vec4(vec3(light.position_radius), 1.0f));
+    int runs = shadowed ? shadow_runs.count : 0;
+    // The lit parts: before each shadowed run, and after the last (k == runs);
+    // one call site, so that GL compiles the segment integral once
+    // (docs/architecture.md, "GL compile time").
     vec3 airlight = vec3(0.0f);
     float lit_from = x0;
-    for (int k = 0; k < shadow_runs.count; ++k) {
-        vec2 run = shadow_runs.run[k];
+    for (int k = 0; k <= runs; ++k) {
+        vec2 run = k < runs ? shadow_runs.run[k] : vec2(x_end);
         if (run.x > lit_from) airlight += point_light_segment(scale, b, h, lit_from, run.x);
         lit_from = max(lit_from, run.y);
     }
-    if (lit_from < x_end) airlight += point_light_segment(scale, b, h, lit_from, x_end);
     return airlight;
 }
 

@@ -292,37 +292,54 @@ vec2 caster_shadow_run(int type, vec3 p0, vec3 p1, vec4 light, vec3 o, vec3 d) {
 // the light (caster_shadow_run's), into shadow_runs: the planes one by one,
 // the bounded surfaces through the BVH, a node's subtree skipped when the
 // node's box, swept away from the light, misses the ray's part [0, t_end];
-// sorted, disjoint.
+// sorted, disjoint. One loop tests one caster per iteration (a plane, a BVH
+// node's box or a leaf's surface) through one call of caster_shadow_run, so
+// that the GL compiler inlines the six shadow-run functions once
+// (docs/architecture.md, "GL compile time").
 void find_shadow_runs(vec3 o, vec3 d, float t_end, vec4 light) {
     shadow_runs.count = 0;
     if (!HAS_SURFACES) return;
-    for (int i = 0; i < frame.plane_count; ++i) {
-        SurfaceGpu surf = surface(i);
-        add_shadow_run(caster_shadow_run(SURFACE_PLANE, vec3(surf.p0), vec3(surf.p1), light, o, d), t_end);
-    }
-    if (frame.bvh_node_count == 0) {
-        merge_shadow_runs();
-        return;
-    }
     int stack[BVH_STACK_SIZE];
     int top = 0;
-    stack[top++] = 0;
-    // Each node at most once; bounded for llvmpipe (geometry.glsl, trace_surfaces_below).
-    for (int visits = 0; visits < frame.bvh_node_count && top > 0; ++visits) {
-        BvhNodeGpu node = bvh_node(stack[--top]);
-        vec2 node_run = caster_shadow_run(SURFACE_BOX, vec3(node.lo), vec3(node.hi), light, o, d);
-        if (!(max(node_run.x, 0.0f) < min(node_run.y, t_end))) continue;
-        if (node.info.y == 0) {
-            if (top + 2 <= BVH_STACK_SIZE) {
-                stack[top++] = node.info.x + 1;
-                stack[top++] = node.info.x;
-            }
+    if (frame.bvh_node_count > 0) stack[top++] = 0;
+    int plane = 0;
+    int leaf_next = 0;  // the leaf's surfaces still to test: [leaf_next, leaf_end)
+    int leaf_end = 0;
+    // Each plane, node and surface at most once; bounded for llvmpipe (geometry.glsl, trace_surfaces_below).
+    int most = frame.plane_count + frame.bvh_node_count + surface_count();
+    for (int visits = 0; visits < most; ++visits) {
+        int type;
+        vec3 p0;
+        vec3 p1;
+        ivec4 node_info = ivec4(-1);  // x, y: a node's first child or surface, its surface count
+        if (plane < frame.plane_count || leaf_next < leaf_end) {
+            SurfaceGpu surf = surface(plane < frame.plane_count ? plane++ : leaf_next++);
+            type = int(surf.albedo_type.w);
+            p0 = vec3(surf.p0);
+            p1 = vec3(surf.p1);
+        } else if (top > 0) {
+            BvhNodeGpu node = bvh_node(stack[--top]);
+            node_info = node.info;
+            type = SURFACE_BOX;
+            p0 = vec3(node.lo);
+            p1 = vec3(node.hi);
+        } else {
+            break;
+        }
+        vec2 run = caster_shadow_run(type, p0, p1, light, o, d);
+        if (node_info.x < 0) {
+            add_shadow_run(run, t_end);
             continue;
         }
-        for (int i = node.info.x; i < node.info.x + node.info.y; ++i) {
-            SurfaceGpu surf = surface(i);
-            add_shadow_run(caster_shadow_run(int(surf.albedo_type.w), vec3(surf.p0), vec3(surf.p1), light, o, d),
-                           t_end);
+        if (!(max(run.x, 0.0f) < min(run.y, t_end))) continue;
+        if (node_info.y == 0) {
+            if (top + 2 <= BVH_STACK_SIZE) {
+                stack[top++] = node_info.x + 1;
+                stack[top++] = node_info.x;
+            }
+        } else {
+            leaf_next = node_info.x;
+            leaf_end = node_info.x + node_info.y;
         }
     }
     merge_shadow_runs();

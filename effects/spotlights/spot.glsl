@@ -377,27 +377,32 @@ vec3 spot_light_airlight(int spot_index, vec3 dir, float x_end, vec3 so_far) {
         return airlight_march(vec3(s.world_position), vec3(s.intensity_edge), spot_index, shadowed,
                               vec3(frame.camera_position), dir, lo + r.b, hi >= NO_HIT ? NO_HIT : hi + r.b);
     }
-    if (!shadowed) return spot_airlight_part(s, r, scale, lo, hi, wall_lo, wall_hi, x_end - x0);
-    // Volumetric shadows: the beam's lit part [lo, hi] less the surfaces'
+    // The beam's lit part [lo, hi] less the surfaces' shadows with volumetric
     // shadows (effects/light_shafts/physics.md section 7); a part's end at a
-    // shadow's edge is no wall of the cone.
+    // shadow's edge is no wall of the cone. The parts before each shadowed run
+    // and after the last (k == runs) go through one call site, so that GL
+    // compiles the beam's integral once (docs/architecture.md, "GL compile time").
     float x_hi = hi >= NO_HIT ? NO_HIT : hi + r.b;
-    find_shadow_runs(vec3(frame.camera_position), dir, x_hi, vec4(vec3(s.world_position), 1.0f));
+    if (shadowed) find_shadow_runs(vec3(frame.camera_position), dir, x_hi, vec4(vec3(s.world_position), 1.0f));
+    int runs = shadowed ? shadow_runs.count : 0;
     vec3 airlight = vec3(0.0f);
     float lit_from = lo + r.b;
+    float part_lo = shadowed ? lit_from - r.b : lo;
     bool wall_from = wall_lo;
-    for (int k = 0; k < shadow_runs.count; ++k) {
-        vec2 run = shadow_runs.run[k];
-        if (run.y <= lit_from) continue;
-        if (run.x > lit_from) {
-            airlight += spot_airlight_part(s, r, scale, lit_from - r.b, run.x - r.b, wall_from, false, run.x - lit_from);
+    for (int k = 0; k <= runs; ++k) {
+        bool last = k == runs;
+        vec2 run = last ? vec2(x_hi) : shadow_runs.run[k];
+        if (!last && run.y <= lit_from) continue;
+        bool lit = last ? (!shadowed || lit_from < x_hi) : run.x > lit_from;
+        if (lit) {
+            float part_hi = last ? hi : run.x - r.b;
+            float clip = !last ? run.x - lit_from
+                               : (!shadowed ? x_end - x0 : (x_hi >= NO_HIT ? NO_HIT : x_hi - lit_from));
+            airlight += spot_airlight_part(s, r, scale, part_lo, part_hi, wall_from, last && wall_hi, clip);
         }
         lit_from = run.y;
+        part_lo = lit_from - r.b;
         wall_from = false;
-    }
-    if (lit_from < x_hi) {
-        airlight += spot_airlight_part(s, r, scale, lit_from - r.b, hi, wall_from, wall_hi,
-                                       x_hi >= NO_HIT ? NO_HIT : x_hi - lit_from);
     }
     return airlight;
 }
