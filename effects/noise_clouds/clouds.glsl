@@ -19,6 +19,10 @@ CONST float CLOUD_VIEW_FAR = 200000.0f;
 // The light march's last step over its first (the steps grow geometrically
 // in between, so that they refine everywhere as their count grows).
 CONST float CLOUD_LIGHT_GROWTH = 16.0f;
+// Neighbouring pieces of the air in the clouds' shadow whose transmittances
+// toward the sun differ by at most this are composed as one (physics.md
+// section 9): the atmosphere's walk runs once for a stretch lit alike.
+CONST float CLOUD_SHADOW_MERGE = 1.0e-3f;
 
 // The height profile H(h, type) (physics.md section 2): a trapezoid in the
 // height fraction h, its corners (rise end a, fall start b, top t) linear in

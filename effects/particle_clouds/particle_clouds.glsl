@@ -181,6 +181,35 @@ void particle_composite(vec3 origin, vec3 dir, float t_hit, OUT(vec3) light, OUT
     }
 }
 
+// The distance along the segment of a 2-D point q + t v after which it lies
+// outside the square [lo, hi] for good (0: outside from the start on).
+float square_exit(vec2 q, vec2 v, vec2 lo, vec2 hi) {
+    float t = NO_HIT;
+    for (int k = 0; k < 2; ++k) {
+        if (v[k] > 0.0f) t = min(t, (hi[k] - q[k]) / v[k]);
+        else if (v[k] < 0.0f) t = min(t, (lo[k] - q[k]) / v[k]);
+        else if (q[k] < lo[k] || q[k] > hi[k]) t = 0.0f;
+    }
+    return max(t, 0.0f);
+}
+
+// The distance along the ray o + t d after which every point's read of the
+// shadow map (particle_sun_transmittance: along the sun below the map's
+// plane, straight below above it) lies off the map, where the sun passes
+// freely (section 5): the later of the two reads' exits from the map's
+// square, each moving linearly with t. NO_HIT without a map.
+float particle_shadow_exit(vec3 o, vec3 d) {
+    vec3 s = vec3(frame.sky.sun_direction);
+    if (frame.particle_clouds.shadow_size.x == 0 || !(s.y > 0.0f)) return NO_HIT;
+    vec4 map = frame.particle_clouds.shadow_map;
+    vec2 lo = vec2(map.x, map.y);
+    vec2 hi = lo + vec2(1.0f / map.z);
+    vec2 slope = vec2(s.x, s.z) / s.y;
+    float below = square_exit(vec2(o.x, o.z) + (map.w - o.y) * slope, vec2(d.x, d.z) - d.y * slope, lo, hi);
+    float above = square_exit(vec2(o.x, o.z), vec2(d.x, d.z), lo, hi);
+    return max(below, above);
+}
+
 // The sun's transmittance through the particles from p (section 5): the
 // shadow map on the plane below them, read where the ray from p toward the
 // sun crosses it (p above the plane: straight below p, the shadow of what

@@ -315,9 +315,11 @@ std::vector<Particle> model_particles(const ParticleClouds& c, const glm::vec3& 
         m.plane = lattice.origin.y;
         std::vector<double> depth(size_t(m.size) * m.size, 0.0);
         const double texel = m.extent / (m.size - 1);
+        m.top = m.plane;
         for (const Particle& p : out) {
             const glm::dvec3 c(p.center);
             const double R = p.radius, sigma = double(p.tau) / R;
+            m.top = std::max(m.top, c.y + R);
             const glm::dvec3 foot = c - ((c.y - m.plane) / s.y) * s;  // the centre's projection along the sun
             const double reach = R / s.y;
             const int i0 = std::max(0, int(std::ceil((foot.x - reach - m.x0) / texel)));

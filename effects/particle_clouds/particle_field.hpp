@@ -48,6 +48,7 @@ struct ParticleFieldStats {
 struct ParticleShadowMap {
     int size = 0;
     double x0 = 0.0, z0 = 0.0, extent = 1.0, plane = 0.0;
+    double top = 0.0;                  // the highest sphere's top (m): the sun lights the air above it
     std::vector<float> transmittance;  // size x size, row j at [j size, (j + 1) size)
 };
 constexpr int PARTICLE_SHADOW_MAP_SIZE = 256;

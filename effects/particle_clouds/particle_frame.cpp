@@ -91,8 +91,13 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
     data.features.particle_clouds = particle_clouds_visible(c);
     if (!data.features.particle_clouds) return;
     const ParticleCamera cam = particle_camera(data);
-    // The shadow map only where surfaces may lie in the particles' shadow (physics.md section 5).
-    const ParticleField field = particle_field(c, cam, glm::vec3(data.frame.sky.sun_direction), data.features.surfaces);
+    // The shadow map only where surfaces, or air that scatters the sun's light, may lie in the
+    // particles' shadow (physics.md section 5).
+    // (The light shafts' medium_sun switch is set after every effect's pack: the sun and a scattering medium.)
+    const bool sunlit_air = data.features.sun && (data.features.atmosphere || data.scattering);
+    const bool air_shadow = scene.quality.cloud_shadow_steps > 0 && sunlit_air;
+    const ParticleField field =
+        particle_field(c, cam, glm::vec3(data.frame.sky.sun_direction), data.features.surfaces || air_shadow);
     // Brute force ("all"): one tile, the whole film, every pixel testing every particle.
     const int tile_size = scene.quality.particle_compositing == ParticleCompositing::tiles
                               ? shader::PARTICLE_TILE_SIZE
@@ -118,6 +123,7 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
         data.use_table(shader::TABLE_PARTICLE_SHADOW, std::move(t));
         g.shadow_map = glm::vec4(float(m.x0), float(m.z0), float(1.0 / m.extent), float(m.plane));
         g.shadow_size = glm::ivec4(m.size, 0, 0, 0);
+        g.air_shadow = glm::vec4(float(m.top), air_shadow ? float(scene.quality.cloud_shadow_steps) : 0.0f, 0.0f, 0.0f);
     }
     if (particles.empty()) particles.assign(8, 0.0f);
     data.use_table(shader::TABLE_PARTICLES,

@@ -17,4 +17,6 @@ struct ParticleCloudsGpu {
     vec4 shadow_map;    // the shadow below (physics.md section 5): x, y: its corner's x, z (m), z: 1 / its extent (1/m),
                         // w: the plane's height (m)
     ivec4 shadow_size;  // x: the map's nodes per side (0: no shadow), y, z, w: unused
+    vec4 air_shadow;    // the particles' shadow in the air (physics.md section 5): x: the highest sphere's top (m),
+                        // y: pieces of the air (quality.cloud_shadow_steps; 0: unshadowed), z, w: unused
 };

@@ -5,8 +5,10 @@
 // composed around the particles (as the noise clouds do, section 6): those
 // behind t_half, where the particles in front pass less than half the light,
 // then the particles (their light in the `particle_clouds` layer), then those
-// in front of t_half. One loop with one call of the media's transfer, so that
-// the shader compiler inlines the atmosphere's walk once.
+// in front of t_half; the air in the particles' shadow (section 5, through
+// the noise clouds' cloud_shadowed_media_transfer). One loop with one call of
+// the media's transfer, so that the shader compiler inlines the atmosphere's
+// walk once.
 vec3 particle_clouds_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_PARTICLE_CLOUDS) return radiance;
     vec3 light;
@@ -23,7 +25,7 @@ vec3 particle_clouds_view_transfer(vec3 origin, vec3 dir, float t_hit, vec3 radi
         }
         float a = i == 0 ? t_half : 0.0f;
         float b = i == 0 ? t_hit : t_half;
-        radiance = media_segment_transfer(origin, dir, a, b, radiance, 1.0f);
+        radiance = cloud_shadowed_media_transfer(origin, dir, a, b, radiance);
     }
     return radiance;
 }
