@@ -12,6 +12,22 @@ vec3 camera_ray_direction(int x, int row) {
                      sy * vec3(frame.camera_up));
 }
 
+// The pixel (x, row) whose camera ray is dir (the inverse of
+// camera_ray_direction); false off the film.
+bool film_pixel_of(vec3 dir, OUT(int) x, OUT(int) row) {
+    vec3 r = vec3(frame.camera_right);
+    vec3 u = vec3(frame.camera_up);
+    float z = dot(dir, vec3(frame.camera_forward));
+    x = -1;
+    row = -1;
+    if (!(z > 0.0f)) return false;
+    float sx = dot(dir, r) / (dot(r, r) * z);
+    float sy = dot(dir, u) / (dot(u, u) * z);
+    x = int(floor(0.5f * (sx + 1.0f) * float(frame.film_width)));
+    row = int(floor(0.5f * (1.0f - sy) * float(frame.film_height)));
+    return x >= 0 && row >= 0 && x < frame.film_width && row < frame.film_height;
+}
+
 // 1/x without dividing by zero (slab tests with axis-parallel rays).
 float safe_inverse(float x) {
     return 1.0f / (abs(x) > 1.0e-20f ? x : (x >= 0.0f ? 1.0e-20f : -1.0e-20f));

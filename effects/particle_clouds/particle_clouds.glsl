@@ -110,15 +110,9 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
 // The screen tile holding the pixel whose ray is dir (the inverse of
 // camera_ray_direction), -1 off the film.
 int particle_tile_of(vec3 dir) {
-    vec3 r = vec3(frame.camera_right);
-    vec3 u = vec3(frame.camera_up);
-    float z = dot(dir, vec3(frame.camera_forward));
-    if (!(z > 0.0f)) return -1;
-    float sx = dot(dir, r) / (dot(r, r) * z);
-    float sy = dot(dir, u) / (dot(u, u) * z);
-    int x = int(floor(0.5f * (sx + 1.0f) * float(frame.film_width)));
-    int row = int(floor(0.5f * (1.0f - sy) * float(frame.film_height)));
-    if (x < 0 || row < 0 || x >= frame.film_width || row >= frame.film_height) return -1;
+    int x;
+    int row;
+    if (!film_pixel_of(dir, x, row)) return -1;
     int size = frame.particle_clouds.tiles.w;
     return (row / size) * frame.particle_clouds.tiles.x + x / size;
 }

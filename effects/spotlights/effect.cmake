@@ -6,7 +6,8 @@ set(EFFECT_FEATURES
     spot_lights=HAS_SPOT_LIGHTS       # spotlights: direct light and cores
     spot_airlight=HAS_SPOT_AIRLIGHT)  # spotlights in a scattering medium
 set(EFFECT_TABLES
-    spot_moments)  # (S, M1/N1, M2/N2, 0) on the airlight tail's grid
+    spot_moments  # (S, M1/N1, M2/N2, 0) on the airlight tail's grid
+    spot_tiles)   # the screen tiles' offsets, then their lists of the spots whose beams can meet their rays
 set(EFFECT_FRAME 1)
 set(EFFECT_FRAME_TABLES 1)
 set(EFFECT_GLSL_LAYOUT spot_layout.glsl)
@@ -21,4 +22,4 @@ set(EFFECT_LAYERS
     "spots=the spotlights' and headlights' light scattered toward the camera by the homogeneous medium")
 set(EFFECT_SCENE_HEADER spot_scene.hpp)
 set(EFFECT_QUALITY SpotQuality)
-set(EFFECT_QUALITY_KEYS spot_glow_samples)
+set(EFFECT_QUALITY_KEYS spot_glow_samples spot_lists)

@@ -12,4 +12,10 @@ struct SpotUniforms {
     float unused0;
     float unused1;
     float unused2;
+    ivec4 tiles;  // the spots' screen tiles (physics.md section 9): x, y: tiles along x and down,
+                  // z: unused, w: a tile's edge in pixels (0: no lists, every ray walks every spot)
 };
+
+// The spots' screen tiles' edge in pixels, and texels per row of their table.
+CONST int SPOT_TILE_SIZE = 16;
+CONST int SPOT_ROW_TEXELS = 2048;

@@ -36,10 +36,27 @@ vec3 spot_light_irradiance(vec3 p, vec3 n, int self, vec3 so_far) {
     return irradiance;
 }
 
-// Hook view_glow: the airlight of every spot over [0, t_hit].
+// Float k of the spots' tile table (spot_frame.cpp): the tiles' offsets, then their lists.
+int spot_tile_entry(int k) {
+    return int(table_texel(TABLE_SPOT_TILES, k % SPOT_ROW_TEXELS, k / SPOT_ROW_TEXELS));
+}
+
+// Hook view_glow: the airlight of every spot whose beam the ray can meet over [0, t_hit].
 vec3 spot_lights_view_glow(vec3 origin, vec3 dir, float t_hit, vec3 radiance) {
     if (!HAS_SPOT_AIRLIGHT) return radiance;
-    for (int i = 0; i < spot_light_count(); ++i) {
+    // The spots whose beams can meet a ray of the pixel's screen tile
+    // (physics.md section 9; spot_frame.cpp), in their order; every spot off
+    // the film or without lists.
+    int x;
+    int row;
+    ivec4 tiles = frame.spot.tiles;
+    bool listed = tiles.w > 0 && film_pixel_of(dir, x, row);
+    int tile = listed ? (row / tiles.w) * tiles.x + x / tiles.w : 0;
+    int header = tiles.x * tiles.y + 1;
+    int begin = listed ? spot_tile_entry(tile) : 0;
+    int end = listed ? spot_tile_entry(tile + 1) : spot_light_count();
+    for (int k = begin; k < end; ++k) {
+        int i = listed ? spot_tile_entry(header + k) : k;
         vec3 airlight = spot_light_airlight(i, dir, t_hit, radiance);
         layer_add(LAYER_SPOTS, airlight);
         radiance += airlight;
