@@ -68,9 +68,11 @@ SPOT = [{"type": "spot", "position": [0, 6, -10], "direction": [0, -1, 0], "inte
 
 
 def test_spot_moment_table_only_for_spots_in_fog():
-    """Point lamps in fog build no spot table; spots in fog build it; spots in clear air nothing."""
+    """Point lamps in fog build no spot table; spots in fog build it, and over surfaces the point
+    lamps' glow table, which bounds a spot's glow for culling (effects/spotlights/physics.md
+    section 5); spots in clear air nothing."""
     assert run([base(lights=LAMP, medium=FOG)])["seen"] == [["airlight_tail", "surface_glow"]]
-    assert run([base(lights=SPOT, medium=FOG)])["seen"] == [["airlight_tail", "spot_moments"]]
+    assert run([base(lights=SPOT, medium=FOG)])["seen"] == [["airlight_tail", "spot_moments", "surface_glow"]]
     assert run([base(lights=SPOT)])["seen"] == [[]]
     stats = run([base(lights=SPOT, medium=FOG)])["stats"]
     assert stats["spot_moments"]["bytes"] == 256 * 64 * 4 * 4
@@ -94,13 +96,16 @@ HG = {"type": "hg", "g": 0.85}
 def test_anisotropic_fog_builds_only_its_lobes_tables():
     """A phase function builds per-lobe slices instead of the isotropic tables: the moment
     slice for lamps' and spots' airlight, the glow slice only where surfaces receive a
-    lamp's glow; each once per distinct lobe; fog without lamps builds nothing."""
+    lamp's or a spot's glow (a lamp's glow bounds a spot's for culling); each once per
+    distinct lobe; fog without lamps builds nothing."""
     assert run([base(medium=fog_with(HG))])["seen"] == [[]]
     with_glow = ["phase_glow g=0.85", "phase_moments g=0.85"]
     assert run([base(lights=LAMP, medium=fog_with(HG))])["seen"] == [with_glow]
     assert run([base(lights=LAMP, medium=fog_with(HG), surfaces=[])])["seen"] == [["phase_moments g=0.85"]]
-    # spots: the moment slice serves their airlight and their glow on surfaces
-    assert run([base(lights=SPOT, medium=fog_with(HG))])["seen"] == [["phase_moments g=0.85"]]
+    # spots: the moment slice serves their airlight and their glow on surfaces, the glow slice
+    # their glow's culling bound; without surfaces, only the moment slice
+    assert run([base(lights=SPOT, medium=fog_with(HG))])["seen"] == [with_glow]
+    assert run([base(lights=SPOT, medium=fog_with(HG), surfaces=[])])["seen"] == [["phase_moments g=0.85"]]
     # a second frame builds nothing new; another g builds its own slices
     other = base(lights=LAMP, medium=fog_with({"type": "hg", "g": -0.3}))
     result = run([base(lights=LAMP, medium=fog_with(HG))] * 2 + [other])

@@ -1,7 +1,7 @@
 """Error and cost of the spots' surface glow against its quadrature resolution
 (effects/spotlights/docs/spot_table.md section 9), measured on the renderer itself:
 
-    .venv/bin/python effects/spotlights/docs/spot_glow_analysis.py [--backend cpu] [--samples 4 8 12 16 24]
+    .venv/bin/python effects/spotlights/docs/spot_glow_analysis.py [--backend cpu] [--samples 4 8 12 16 24] [--parts 1 2 3 4 5]
 
 1. Convergence: road scenes lit by one spot (street lamp, headlight, spot by the
    from above: CASES below), rendered at each
@@ -17,6 +17,20 @@
    available): as shipped, with spot_glow_samples 8, and with black surfaces
    (which skips all surface lighting, so the difference is the lighting).
 
+4. The glow alone, per spot (what the surface culling's coarse rule rests on,
+   effects/lamp_airlight/docs/culling.md): the glow at n samples against 64,
+   max relative error over the road pixels of each case where the glow is
+   above 1e-6 of its largest and above 1e-3 of the road's own radiance
+   (below that, the glow is measured as a difference of renders and float32
+   rounding of the direct light hides it). The glow is separated from the
+   direct light by rendering the road grey and black, with the medium's
+   albedo 0.9 and 0 (sigma_t unchanged: only the glow and airlight change).
+
+5. The 64-headlight street of effects/lamp_airlight/bench/bench_airlight.py over a grey
+   road and buildings (albedo 0.3), 160x90: frame time with the default culling and
+   with culling off, and the largest relative change culling makes, on each backend;
+   the spots' glows are most of this frame.
+
 Timings are whole frames on a shared machine: compare ratios.
 """
 
@@ -24,7 +38,9 @@ from __future__ import annotations
 
 import argparse
 import copy
+import sys
 import time
+from pathlib import Path
 from typing import Any
 
 import numpy as np
@@ -81,9 +97,22 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--backend", default="cpu")
     ap.add_argument("--samples", type=int, nargs="+", default=[4, 8, 12, 16, 24])
+    ap.add_argument("--parts", type=int, nargs="+", default=[1, 2, 3, 4, 5])
     args = ap.parse_args()
     renderer = airlight.Renderer(args.backend)
+    if 1 in args.parts:
+        convergence(renderer, args)
+    if 2 in args.parts:
+        two_spots_are_a_lamp(renderer, args)
+    if 3 in args.parts:
+        preset_frame_cost()
+    if 4 in args.parts:
+        glow_alone(renderer, args)
+    if 5 in args.parts:
+        grey_headlight_street()
 
+
+def convergence(renderer: airlight.Renderer, args: argparse.Namespace) -> None:
     print(f"1. max relative pixel error against 64 samples, and frame time ({args.backend}, 160x120)")
     print(f"  {'case':32} " + " ".join(f"{'n=' + str(n):>17}" for n in args.samples))
     worst = {n: 0.0 for n in args.samples}
@@ -98,6 +127,8 @@ def main() -> None:
         print(f"  {name:32} " + " ".join(f"{c:>17}" for c in cells))
     print(f"  {'worst':32} " + " ".join(f"{worst[n]:8.1e}{'':9}" for n in args.samples))
 
+
+def two_spots_are_a_lamp(renderer: airlight.Renderer, args: argparse.Namespace) -> None:
     print("\n2. two opposite 90-degree spots (q = 1) against one point lamp (G table): "
           "max relative pixel error")
     for sigma in (0.001, 0.04, 0.3, 1.5):
@@ -123,6 +154,7 @@ def main() -> None:
             print(f"  sigma_t {sigma:<6} lamp at {str(position):14} " + "  ".join(cells))
 
 
+def preset_frame_cost() -> None:
     print("\n3. frame time of the spot presets at 320x180: as shipped | spot_glow_samples 8 | black surfaces")
     for backend in airlight.available_backends():
         frame_renderer = airlight.Renderer(backend)
@@ -136,6 +168,55 @@ def main() -> None:
                 surface["albedo"] = 0.0
             times = [1e3 * timed(frame_renderer, sc)[0] for sc in (shipped, fewer, black)]
             print(f"  {backend:4} {name:24} " + " | ".join(f"{t:6.0f} ms" for t in times))
+
+
+def road_glow(renderer: airlight.Renderer, scene: dict) -> tuple[np.ndarray, np.ndarray]:
+    """The road's glow and its own radiance (direct light + glow, times the transmittance) in
+    `scene` with culling off, from four renders (road grey and black, medium albedo 0.9 and 0)."""
+    def road_term(medium_albedo: float) -> np.ndarray:
+        grey = copy.deepcopy(scene)
+        grey["medium"]["albedo"] = medium_albedo
+        grey["quality"]["cull_fraction"] = 0.0
+        black = copy.deepcopy(grey)
+        for surface in black["surfaces"]:
+            surface["albedo"] = 0.0
+        return (np.asarray(renderer.render(grey), np.float64) - np.asarray(renderer.render(black), np.float64))
+    lit = road_term(0.9)
+    return lit - road_term(0.0), lit
+
+
+def glow_alone(renderer: airlight.Renderer, args: argparse.Namespace) -> None:
+    print(f"\n4. the glow alone: max relative error against 64 samples ({args.backend}, 160x120)")
+    print(f"  {'case':36} " + " ".join(f"{'n=' + str(n):>9}" for n in args.samples) + "   pixels")
+    worst = {n: 0.0 for n in args.samples}
+    for name, kw in CASES:
+        ref, road = road_glow(renderer, road_scene(64, **kw))
+        mask = (ref > 1e-6 * ref.max()) & (ref > 1e-3 * road)
+        cells = []
+        for n in args.samples:
+            glow, _ = road_glow(renderer, road_scene(n, **kw))
+            err = float(np.max(np.abs(glow[mask] / ref[mask] - 1.0)))
+            worst[n] = max(worst[n], err)
+            cells.append(f"{err:9.1e}")
+        print(f"  {name:36} " + " ".join(cells) + f"   {int(mask.sum()):6d}")
+    print(f"  {'worst':36} " + " ".join(f"{worst[n]:9.1e}" for n in args.samples))
+
+
+def grey_headlight_street() -> None:
+    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lamp_airlight" / "bench"))
+    import bench_airlight
+
+    scene = bench_airlight.street_scene(64, 160, 90, surface_albedo=0.3, light_type="headlights")
+    print("\n5. 64 headlights over a grey street, 160x90: frame time culled (default) | unculled, "
+          "largest relative change")
+    for backend in airlight.available_backends():
+        frame_renderer = airlight.Renderer(backend)
+        unculled = copy.deepcopy(scene)
+        unculled["quality"] = {"cull_fraction": 0.0}
+        t_culled, culled_image = timed(frame_renderer, scene)
+        t_unculled, unculled_image = timed(frame_renderer, unculled)
+        change = float(np.max(np.abs(culled_image - unculled_image) / np.maximum(unculled_image, 1e-30)))
+        print(f"  {backend:4} {t_culled:7.2f} s | {t_unculled:7.2f} s ({t_unculled / t_culled:4.2f}x)   {change:.1e}")
 
 
 if __name__ == "__main__":
