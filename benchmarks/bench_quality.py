@@ -32,7 +32,6 @@ from __future__ import annotations
 
 import argparse
 import copy
-import importlib.util
 import json
 import statistics
 import sys
@@ -47,6 +46,7 @@ import airlight
 
 ROOT = Path(__file__).resolve().parents[1]
 sys.path.insert(0, str(ROOT))
+from effects.lamp_airlight.bench.bench_airlight import street_scene  # noqa: E402
 from tools.fuzz.compare import error_against_reference  # noqa: E402
 
 PRESETS = ("fast", "default", "reference")
@@ -54,13 +54,7 @@ PRESETS = ("fast", "default", "reference")
 
 def _street(lights: int, light_type: str, surface_albedo: float) -> dict[str, Any]:
     """bench_airlight's street."""
-    path = ROOT / "effects" / "lamp_airlight" / "bench" / "bench_airlight.py"
-    spec = importlib.util.spec_from_file_location("bench_airlight", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    scene: dict[str, Any] = module.street_scene(lights, 640, 360, surface_albedo, light_type)
-    return scene
+    return street_scene(lights, 640, 360, surface_albedo, light_type)
 
 
 def _preset(name: str) -> dict[str, Any]:

@@ -14,8 +14,8 @@ from __future__ import annotations
 
 import argparse
 import copy
-import importlib.util
 import statistics
+import sys
 import time
 from pathlib import Path
 from typing import Any
@@ -25,16 +25,13 @@ import numpy as np
 import airlight
 
 ROOT = Path(__file__).resolve().parents[3]
+sys.path.insert(0, str(ROOT))
+from effects.lamp_airlight.bench.bench_airlight import street_scene  # noqa: E402
 
 
 def headlight_street(width: int, height: int) -> dict[str, Any]:
-    path = ROOT / "effects" / "lamp_airlight" / "bench" / "bench_airlight.py"
-    spec = importlib.util.spec_from_file_location("bench_airlight", path)
-    assert spec is not None and spec.loader is not None
-    module = importlib.util.module_from_spec(spec)
-    spec.loader.exec_module(module)
-    scene: dict[str, Any] = module.street_scene(64, width, height, 0.0, "headlights")
-    return scene
+    """bench_airlight's street of 32 cars' headlights over black surfaces."""
+    return street_scene(64, width, height, 0.0, "headlights")
 
 
 def frame(renderer: airlight.Renderer, scene: dict[str, Any], frames: int) -> tuple[np.ndarray, float]:

@@ -203,10 +203,10 @@ def glow_alone(renderer: airlight.Renderer, args: argparse.Namespace) -> None:
 
 
 def grey_headlight_street() -> None:
-    sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lamp_airlight" / "bench"))
-    import bench_airlight
+    sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+    from effects.lamp_airlight.bench.bench_airlight import street_scene
 
-    scene = bench_airlight.street_scene(64, 160, 90, surface_albedo=0.3, light_type="headlights")
+    scene = street_scene(64, 160, 90, surface_albedo=0.3, light_type="headlights")
     print("\n5. 64 headlights over a grey street, 160x90: frame time culled (default) | unculled, "
           "largest relative change")
     for backend in airlight.available_backends():

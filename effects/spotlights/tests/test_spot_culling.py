@@ -28,8 +28,8 @@ import pytest
 from airlight_reference import get_renderer, make_scene, plane
 from spot_reference import spot
 
-sys.path.insert(0, str(Path(__file__).resolve().parents[2] / "lamp_airlight" / "bench"))
-import bench_airlight  # noqa: E402  (the benchmark's street, the scene this culling was made for)
+sys.path.insert(0, str(Path(__file__).resolve().parents[3]))
+from effects.lamp_airlight.bench.bench_airlight import street_scene  # noqa: E402  (the scene this culling was made for)
 
 CULL_FRACTIONS = np.geomspace(1e-6, 1e-2, 24)  # the key's range is [0, 0.01]
 
@@ -61,7 +61,7 @@ def _assert_culling_within(exact_scene: dict, cull_fraction: float | None, backe
 
 
 def _grey_headlight_street() -> dict:
-    scene = bench_airlight.street_scene(64, 40, 24, surface_albedo=0.3, light_type="headlights")
+    scene = street_scene(64, 40, 24, surface_albedo=0.3, light_type="headlights")
     scene["quality"] = {"cull_fraction": 0.0}
     return scene
 
