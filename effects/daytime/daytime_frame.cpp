@@ -19,7 +19,7 @@ static void pack_aerial_table(const Scene& scene, FrameData& data) {
         particle_clouds_visible(scene.particle_clouds))
         return;
     shader::FrameUniforms& f = data.frame;
-    const int rows = 4 * nodes + 1;  // odd: the horizon is a row
+    const int rows = 12 * nodes + 1;  // odd: the horizon is a row
     // The diffuse light depends on the azimuth from the sun with a sun (its
     // multiple scattering) or a sky with an indicatrix.
     const bool azimuth = data.features.sun || f.atmosphere.sky_table_azimuth_blocks > 1.0f;

@@ -40,8 +40,10 @@ QUICK_CASES = ["rain_10", "camera_0_up", "sun_low_ahead_clear", "pitch_-60_rain"
 
 # High cameras: a ray from 3-10 km crosses the low, dense layers within a few distance nodes, and
 # rows of neighbouring elevations meet the ground kilometres apart (section 3 of the document).
+# Cameras up to 1 km are held to the sweep at 32 nodes, those above at 64.
+HIGH_CAMERA_ALTITUDE = 1000.0
 TABLE_KNOWN_FAILURES = {
-    "camera_3km_down": "camera 3 km up looking down: 3.5 % at 32 nodes, 1.03 % at 64",
+    "camera_3km_down": "camera 3 km up looking down: 1.03 % at 64 nodes",
     "camera_10km_down": "camera 10 km up looking down: over 1 % at 64 nodes",
     "camera_10km_horizon": "camera 10 km up at the horizon: over 1 % at 64 nodes",
 }
@@ -67,9 +69,11 @@ def test_aerial_table_matches_the_reference_quadrature(renderer, case):
     ],
 )
 def test_aerial_table_matches_the_reference_quadrature_everywhere(renderer, case):
-    """The whole sweep at 64 distance nodes (32 leave up to 3.5 % on cameras 3-10 km up looking
-    down and 1.2 % in rain of 100 mm/h: effects/daytime/docs/aerial_table.md section 3)."""
-    image = renderer.render(with_table(case_scene(case), 64))[:, 0]
+    """The whole sweep: cameras up to 1 km at 32 distance nodes, higher ones at 64 (32 leave 2.6 %
+    on the 3 km camera at the horizon: effects/daytime/docs/aerial_table.md section 3)."""
+    scene = case_scene(case)
+    nodes = 64 if scene["camera"]["position"][1] > HIGH_CAMERA_ALTITUDE else 32
+    image = renderer.render(with_table(scene, nodes))[:, 0]
     finite_non_negative(image, case)
     assert relative_error(image, expected_column(case)) <= REL_TOL
 
