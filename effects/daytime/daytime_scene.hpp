@@ -93,7 +93,7 @@ struct DaytimeQuality {
     int sky_segments = 16;
     // The aerial table (effects/daytime/docs/aerial_table.md): 0 walks the
     // scattering volumes in every pixel; N in [8, 64] tabulates the light
-    // along camera rays once per frame at N distance nodes (4N + 1 elevation
+    // along camera rays once per frame at N distance nodes (12N + 1 elevation
     // rows, N azimuth blocks where the light depends on the azimuth) and
     // interpolates it per pixel.
     int aerial_table = 0;
