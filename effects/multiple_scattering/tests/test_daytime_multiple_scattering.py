@@ -30,15 +30,24 @@ DAY = ms_cases.load_cases("day")["cases"]
 ACCEPT_FRACTION = 0.96
 
 
+def render_views(case: dict, quality: dict | None = None) -> np.ndarray:
+    """airlight's radiance (CPU) of every view of a case, with ``quality`` keys added:
+    [view, channel]."""
+    renderer = airlight.Renderer("cpu")
+    out = []
+    for i in range(len(case["views"])):
+        scene = ms_cases.view_scene(case, i)
+        if quality:
+            scene["quality"] = {**scene.get("quality", {}), **quality}
+        out.append(renderer.render(scene)[0, 0, :3])
+    renderer.close()
+    return np.array(out)
+
+
 @functools.cache
 def rendered_views(name: str) -> np.ndarray:
-    """airlight's radiance (CPU) of every view of a stored case: [view, channel]."""
-    renderer = airlight.Renderer("cpu")
-    case = DAY[name]
-    out = np.array([renderer.render(ms_cases.view_scene(case, i))[0, 0, :3]
-                    for i in range(len(case["views"]))])
-    renderer.close()
-    return out
+    """The default render of every view of a stored case (render_views), computed once."""
+    return render_views(DAY[name])
 
 
 def reference_views(name: str, key: str = "radiance") -> np.ndarray:
@@ -75,20 +84,8 @@ def test_aerial_table_agrees_with_the_march_where_rain_misses_the_path_tracer(na
     table (effects/daytime/docs/aerial_table.md section 3) every view agrees with the brute-force
     march of the same multiple-scattering field within 0.5 % (measured 0.21 %), where the volumes
     at 16 levels are up to 2.7 % off it: the bias is the field's, not the table's."""
-    renderer = airlight.Renderer("cpu")
-    case = DAY[name]
-
-    def views(quality: dict) -> np.ndarray:
-        out = []
-        for i in range(len(case["views"])):
-            scene = ms_cases.view_scene(case, i)
-            scene["quality"] = {**scene.get("quality", {}), **quality}
-            out.append(renderer.render(scene)[0, 0, :3])
-        return np.array(out)
-
-    march = views({"airlight": "march", "march_steps": 4000})
-    table = views({"aerial_table": 16})
-    renderer.close()
+    march = render_views(DAY[name], {"airlight": "march", "march_steps": 4000})
+    table = render_views(DAY[name], {"aerial_table": 16})
     assert np.max(np.abs(table / march - 1)) <= 5e-3
 
 
