@@ -67,6 +67,9 @@ HALF_WIDTH = 5.0e6  # m, half the slab's width
 TEXEL_SCALE_FRACTION = 0.01  # texel height / the local scale height of the extinction
 MAX_TEXELS = 4096
 THIN_LAYER_DEPTH = 0.2  # a layer may span several e-folds while its majorant depth is below this
+# The thinnest layer Mitsuba can hold: its two null interfaces, float32 rectangles 2 x HALF_WIDTH
+# wide, must be told apart (a 0.55 m layer at the rain's top lost 2-3 % of the rain's light).
+MIN_LAYER_THICKNESS = 10.0  # m
 ENVMAP_HEIGHT = 1025  # rows (nodes) of the sky bitmap over 180 degrees: 0.176 degree apart
 BATCH = 1 << 18  # samples per volpath.sample call
 
@@ -152,27 +155,42 @@ def discretise(atm: ref.Atmosphere, channel: int, top: float | None = None) -> l
     edges_l = [0.0]
     for a, b in zip(breaks[:-1], breaks[1:]):
         idx = np.nonzero((fine >= a) & (fine <= b))[0]
+        # The extinction inside [a, b]: at b its left limit (a profile that ends at b, the rain's
+        # top, is 0 there, and taking that value would split off a spurious layer a fine step
+        # thin, whose two interfaces Mitsuba's float32 intersections cannot tell apart).
+        inside = smax[idx].copy()
+        inside[-1] = float(atm.sigma_t(np.array([b - 1e-6 * (b - a)])).max())
         start = idx[0]
-        lo_s = hi_s = float(smax[start])
-        for j in idx[1:]:
-            lo_s, hi_s = min(lo_s, float(smax[j])), max(hi_s, float(smax[j]))
+        lo_s = hi_s = float(inside[0])
+        for k, j in enumerate(idx[1:], start=1):
+            s_j = float(inside[k])
+            lo_s, hi_s = min(lo_s, s_j), max(hi_s, s_j)
             ok = hi_s <= math.e * lo_s or hi_s * (fine[j] - fine[start]) <= THIN_LAYER_DEPTH
             if not ok:
                 edges_l.append(float(fine[j - 1]))
                 start = j - 1
-                lo_s = min(float(smax[j - 1]), float(smax[j]))
-                hi_s = max(float(smax[j - 1]), float(smax[j]))
+                lo_s = min(float(inside[k - 1]), s_j)
+                hi_s = max(float(inside[k - 1]), s_j)
         edges_l.append(float(b))
-    edges_l = sorted(set(edges_l))
+    # No layer thinner than MIN_LAYER_THICKNESS: an edge that is not a profile break gives way.
+    kept: list[float] = []
+    for e in sorted(set(edges_l)):
+        if e in breaks:
+            while kept and kept[-1] not in breaks and e - kept[-1] < MIN_LAYER_THICKNESS:
+                kept.pop()
+            kept.append(e)
+        elif not kept or e - kept[-1] >= MIN_LAYER_THICKNESS:
+            kept.append(e)
+    edges_l = kept
     layers = []
     slots = _species_shares(atm)
     for y0, y1 in zip(edges_l[:-1], edges_l[1:]):
-        seg = (fine >= y0) & (fine <= y1)
-        st = atm.sigma_t(fine[seg]).max(axis=-1)
+        ys = np.minimum(fine[(fine >= y0) & (fine <= y1)], y1 - 1e-6 * (y1 - y0))  # y1: its left limit
+        st = atm.sigma_t(ys).max(axis=-1)
         # local scale height of the extinction: |d ln sigma / dy|^-1, at least that of its species
         with np.errstate(divide="ignore", invalid="ignore"):
             lns = np.log(np.maximum(st, 1e-300))
-            grad = np.abs(np.diff(lns) / np.diff(fine[seg])) if seg.sum() > 1 else np.zeros(1)
+            grad = np.abs(np.diff(lns) / np.diff(ys)) if ys.size > 1 else np.zeros(1)
         h_local = 1.0 / max(float(np.nanmax(grad)) if grad.size else 0.0, 1.0 / (y1 - y0))
         n = int(min(MAX_TEXELS, max(8, math.ceil((y1 - y0) / (TEXEL_SCALE_FRACTION * h_local)))))
         edges = np.linspace(y0, y1, n + 1)
