@@ -85,6 +85,9 @@ struct Atmosphere {
     bool any() const { return molecules.present || aerosol.present || rain.present; }
 };
 
+// quality.aerial_table "auto": the node count is chosen per frame.
+constexpr int AERIAL_TABLE_AUTO = -1;
+
 // The daytime effect's quality setting (a base of Quality).
 struct DaytimeQuality {
     // Accuracy knob of the daytime scattering volumes (effects/daytime/physics.md):
@@ -95,8 +98,10 @@ struct DaytimeQuality {
     // scattering volumes in every pixel; N in [8, 64] tabulates the light
     // along camera rays once per frame at N distance nodes (12N + 1 elevation
     // rows, N azimuth blocks where the light depends on the azimuth) and
-    // interpolates it per pixel.
-    int aerial_table = 0;
+    // interpolates it per pixel; AERIAL_TABLE_AUTO ("auto", the default)
+    // chooses by the camera's altitude and the film's size
+    // (auto_aerial_nodes, daytime_frame.cpp).
+    int aerial_table = AERIAL_TABLE_AUTO;
 };
 
 }  // namespace airlight

@@ -128,12 +128,39 @@ def test_aerial_table_key_is_validated_and_written_back():
     with pytest.raises(ValueError, match="quality.aerial_table"):
         airlight.load_scene(scene)
     scene["quality"] = {"aerial_table": "many"}
-    with pytest.raises(TypeError, match="quality.aerial_table"):
+    with pytest.raises(ValueError, match="quality.aerial_table"):
         airlight.load_scene(scene)
+    scene["quality"] = {"aerial_table": 16.5}
+    with pytest.raises(ValueError, match="quality.aerial_table"):
+        airlight.load_scene(scene)
+    scene["quality"] = {}
+    assert airlight.load_scene(scene)["quality"]["aerial_table"] == "auto"
+    scene["quality"] = {"preset": "fast"}
+    assert airlight.load_scene(scene)["quality"]["aerial_table"] == "auto"
+    scene["quality"] = {"preset": "reference"}
+    assert airlight.load_scene(scene)["quality"]["aerial_table"] == 0
     scene["quality"] = {"aerial_table": 24}
     assert airlight.load_scene(scene)["quality"]["aerial_table"] == 24
     scene["quality"] = {"preset": "reference", "aerial_table": 24}
     assert airlight.load_scene(scene)["quality"]["aerial_table"] == 24
+
+
+@pytest.mark.parametrize(("altitude", "width", "height", "nodes"), [
+    (1.7, 320, 180, 16), (20.0, 240, 240, 16), (21.0, 320, 180, 0), (500.0, 320, 180, 0),
+    (1.7, 319, 180, 0), (1.7, 1, 1, 0)])
+def test_auto_tabulates_for_street_cameras_on_big_films(renderer, altitude, width, height, nodes):
+    """quality.aerial_table "auto" (the default; section 6 of the document) renders exactly what
+    its choice renders: 16 nodes for a camera up to 20 m above the ground on films of at least
+    320 x 180 pixels; the volumes (0) on smaller films and for higher cameras."""
+    scene = airlight.preset("day_heavy_rain")
+    scene["film"] = {"width": width, "height": height}
+    scene["camera"]["position"][1] = altitude
+    scene["camera"]["look_at"][1] = altitude - 0.3 * altitude
+    auto = renderer.render(scene)
+    np.testing.assert_array_equal(auto, renderer.render(with_table(scene, nodes)))
+    # and the other choice differs: the test sees which one ran
+    other = 0 if nodes else 16
+    assert np.max(np.abs(auto - renderer.render(with_table(scene, other)))) > 0.0
 
 
 @pytest.mark.slow

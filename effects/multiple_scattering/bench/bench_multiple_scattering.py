@@ -8,10 +8,11 @@
 1. Accuracy against the stored Mitsuba reference (effects/multiple_scattering/tests/data/
    day_reference.json: 24 weathers and suns x 14 views x 3 channels; path-traced, unlimited
    depth): per case the share of values within max(3 %, 3 standard errors) and the median and
-   largest relative error, for the table method (the default), for brute-force marching of the
-   same field (`"airlight": "march"`: the source sampled at every step instead of integrated
-   over scattering volumes), and for single scattering alone (`quality.multiple_scattering`
-   false: what the renderer gave before).
+   largest relative error, for the field's table integrated over the scattering volumes (the
+   default), through the aerial table (`quality.aerial_table` 32: effects/daytime/docs/
+   aerial_table.md), for brute-force marching of the same field (`"airlight": "march"`: the
+   source sampled at every step instead of integrated over scattering volumes), and for single
+   scattering alone (`quality.multiple_scattering` false: what the renderer gave before).
 2. The solve per weather state: time and table size (a fresh process per state, so that
    nothing is cached), and the solver levels.
 3. The per-pixel cost: a frame of the day presets' weathers over open fields (camera 1.7 m up,
@@ -45,7 +46,8 @@ import ms_cases  # noqa: E402
 def accuracy(march_steps: list[int]) -> tuple[list[str], dict]:
     cases = ms_cases.load_cases("day")["cases"]
     renderer = airlight.Renderer("cpu")
-    methods = [("table", {}), *[(f"march {n}", {"airlight": "march", "march_steps": n}) for n in march_steps],
+    methods = [("volumes", {}), ("aerial table 32", {"aerial_table": 32}),
+               *[(f"march {n}", {"airlight": "march", "march_steps": n}) for n in march_steps],
                ("single only", {"multiple_scattering": False})]
     lines = ["| case | " + " | ".join(f"{m}: within / median / max" for m, _ in methods) + " |",
              "|---|" + "---|" * len(methods)]
@@ -154,7 +156,7 @@ def plot(totals: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 4.0))
-    for method in ("table", "single only"):
+    for method in ("volumes", "aerial table 32", "single only"):
         got = np.concatenate([t[0] for t in totals[method]]).ravel()
         want = np.concatenate([t[1] for t in totals[method]]).ravel()
         ax.loglog(want, got, ".", ms=3, label=f"airlight, {method}")

@@ -1,7 +1,9 @@
 """The renderer's daytime multiple scattering (issue 18; effects/multiple_scattering/physics.md
 section 9; effects/multiple_scattering/docs/renderer.md): the views of the stored Mitsuba
 reference (24 weathers and suns, 14 views, 3 channels) within max(3 %, 3 path-tracer standard
-errors) on 96 % of the values (the issue asks 99 %; renderer.md says where the rest are);
+errors) on 99 % of the values through the aerial table (the default for street cameras on films of
+320 x 180 and more; the issue asks 99 %) and on 97 % through the scattering volumes (renderer.md
+says where the rest are);
 ``quality.multiple_scattering`` false is single scattering exactly; an atmosphere that does not
 scatter builds no solve; the ground's reflection reaches walls continuously as the air thins; no
 NaN or Inf over a wide sweep; GL equals the CPU."""
@@ -17,6 +19,7 @@ import textwrap
 
 import ms_cases
 import numpy as np
+import plane_parallel_mc
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -24,10 +27,12 @@ from hypothesis import strategies as st
 import airlight
 
 DAY = ms_cases.load_cases("day")["cases"]
-# Share of the reference's values within the allowed deviation: measured 0.966 (the issue asks 0.99;
-# the misses are rain of 40 and 100 mm/h, 3-5 % above the path tracer:
-# effects/multiple_scattering/docs/renderer.md section 2).
-ACCEPT_FRACTION = 0.96
+# Share of the reference's values within the allowed deviation (the issue asks 0.99): through the
+# aerial table at 16 nodes measured 0.998, through the volumes at 16 levels 0.977 (their misses: rain
+# of 40 and 100 mm/h near the horizon, 2-5 % below; effects/multiple_scattering/docs/renderer.md
+# section 2).
+ACCEPT_FRACTION_TABLE = 0.99
+ACCEPT_FRACTION_VOLUMES = 0.97
 
 
 def render_views(case: dict, quality: dict | None = None) -> np.ndarray:
@@ -54,16 +59,28 @@ def reference_views(name: str, key: str = "radiance") -> np.ndarray:
     return np.array([v[key] for v in DAY[name]["views"]])
 
 
-def test_daytime_radiance_matches_the_path_tracer_on_96_percent_of_values() -> None:
+def test_daytime_radiance_matches_the_path_tracer_on_97_percent_of_values_through_the_volumes() -> None:
     """The issue's acceptance measure: sky and ground radiance within 3 % (or the path tracer's
     noise) over clear, hazy, rain 3/40/100 mm/h and fog of 50-200 m under a high, a low and no
-    sun; on 96 % of the values (99 % asked), and none beyond 2.5 allowed deviations."""
+    sun. Through the scattering volumes at 16 levels (what these one-pixel views get by default):
+    on 97 % of the values, and none beyond 2 allowed deviations (measured 1.76)."""
     got = np.concatenate([rendered_views(n) for n in sorted(DAY)])
     want = np.concatenate([reference_views(n) for n in sorted(DAY)])
     err = np.concatenate([reference_views(n, "stderr") for n in sorted(DAY)])
-    assert ms_cases.fraction_within(got, want, err) >= ACCEPT_FRACTION
-    # and none is far off: the worst within 2.5 allowed deviations (measured 2.09)
-    assert np.max(np.abs(got - want) / ms_cases.allowed_deviation(want, err)) < 2.5
+    assert ms_cases.fraction_within(got, want, err) >= ACCEPT_FRACTION_VOLUMES
+    assert np.max(np.abs(got - want) / ms_cases.allowed_deviation(want, err)) < 2.0
+
+
+@pytest.mark.slow
+def test_daytime_radiance_matches_the_path_tracer_on_99_percent_of_values_through_the_aerial_table() -> None:
+    """The same measure through the aerial table at 16 nodes (effects/daytime/docs/aerial_table.md;
+    what a street camera's film of 320 x 180 or more gets by default): the issue's 99 % of the
+    values (measured 99.8 %: two of 1008 miss, by 1.3 and 1.03 allowed deviations)."""
+    got = np.concatenate([render_views(DAY[n], {"aerial_table": 16}) for n in sorted(DAY)])
+    want = np.concatenate([reference_views(n) for n in sorted(DAY)])
+    err = np.concatenate([reference_views(n, "stderr") for n in sorted(DAY)])
+    assert ms_cases.fraction_within(got, want, err) >= ACCEPT_FRACTION_TABLE
+    assert np.max(np.abs(got - want) / ms_cases.allowed_deviation(want, err)) < 1.5
 
 
 @pytest.mark.parametrize("name", ["day_rain40_overcast", "day_fog50_sun60", "day_clear_sun10"])
@@ -79,14 +96,35 @@ def test_multiple_scattering_is_most_of_the_light_in_rain_and_fog(name: str) -> 
 
 
 @pytest.mark.parametrize("name", ["day_rain40_overcast", "day_rain100_sun10"])
-def test_aerial_table_agrees_with_the_march_where_rain_misses_the_path_tracer(name: str) -> None:
-    """The rain views are 2-3.5 % above the path tracer (the misses above). Through the aerial
-    table (effects/daytime/docs/aerial_table.md section 3) every view agrees with the brute-force
-    march of the same multiple-scattering field within 0.5 % (measured 0.21 %), where the volumes
-    at 16 levels are up to 2.7 % off it: the bias is the field's, not the table's."""
+def test_aerial_table_agrees_with_the_march_in_rain(name: str) -> None:
+    """In rain the volumes at 16 levels are up to 2.7 % below the brute-force march of the same
+    multiple-scattering field (the misses above). Through the aerial table
+    (effects/daytime/docs/aerial_table.md section 3) every view agrees with the march of 4000 steps
+    within 0.5 % (measured 0.21 %): the table, not the field, is what the volumes miss."""
     march = render_views(DAY[name], {"airlight": "march", "march_steps": 4000})
     table = render_views(DAY[name], {"aerial_table": 16})
     assert np.max(np.abs(table / march - 1)) <= 5e-3
+
+
+@pytest.mark.slow
+def test_table_and_path_tracer_agree_with_an_analog_monte_carlo_in_rain() -> None:
+    """A third reference that shares neither the solver nor Mitsuba's scene and estimators
+    (plane_parallel_mc.py, an analog walk in altitude and direction cosine) on six views of
+    day_rain40_overcast (green): airlight through the aerial table within 4 of its standard
+    errors + 0.5 % on every view (measured 0.2 %), and the stored path tracer's values within 1 %
+    of it on average (they were 2 % dark before the reference's layering was fixed:
+    effects/multiple_scattering/docs/reference.md section 3)."""
+    case = DAY["day_rain40_overcast"]
+    views = [0, 1, 4, 6, 11, 12]
+    table = render_views(case, {"aerial_table": 16})[:, 1]
+    ratios = []
+    for i in views:
+        view = case["views"][i]
+        walk = plane_parallel_mc.overcast_view_radiance(case["scene"], 1, view["direction"][1], 100_000,
+                                                        seed=i)
+        assert abs(table[i] - walk.mean) <= 4.0 * walk.stderr + 5e-3 * walk.mean, (i, table[i], walk)
+        ratios.append(view["radiance"][1] / walk.mean)
+    assert abs(np.mean(ratios) - 1.0) <= 0.01, ratios
 
 
 @pytest.mark.parametrize("name", ["day_clear_sun60", "day_rain100_sun10", "day_fog100_overcast"])
