@@ -174,18 +174,16 @@ void preset_daytime_quality(QualityPreset preset, Scene& s) {
 void parse_daytime_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("sky_segments")) s.quality.sky_segments = read_int(*v, 2, 64);
     if (auto v = quality.opt("aerial_table")) {
+        const auto bad = [](const std::string& got) {
+            throw SceneError(SceneError::Kind::value, "quality.aerial_table",
+                             "\"auto\", 0 (off) or 8 to 64 distance nodes, got " + got);
+        };
         if (v->j.is_string()) {
-            if (v->j.get<std::string>() != "auto")
-                throw SceneError(
-                    SceneError::Kind::value, "quality.aerial_table",
-                    "\"auto\", 0 (off) or 8 to 64 distance nodes, got \"" + v->j.get<std::string>() + "\"");
+            if (v->j.get<std::string>() != "auto") bad("\"" + v->j.get<std::string>() + "\"");
             s.quality.aerial_table = AERIAL_TABLE_AUTO;
         } else {
             s.quality.aerial_table = read_int(*v, 0, 64);
-            if (s.quality.aerial_table != 0 && s.quality.aerial_table < 8)
-                throw SceneError(
-                    SceneError::Kind::value, "quality.aerial_table",
-                    "\"auto\", 0 (off) or 8 to 64 distance nodes, got " + std::to_string(s.quality.aerial_table));
+            if (s.quality.aerial_table != 0 && s.quality.aerial_table < 8) bad(std::to_string(s.quality.aerial_table));
         }
     }
 }

@@ -9,7 +9,7 @@
    day_reference.json: 24 weathers and suns x 14 views x 3 channels; path-traced, unlimited
    depth): per case the share of values within max(3 %, 3 standard errors) and the median and
    largest relative error, for the field's table integrated over the scattering volumes (the
-   default), through the aerial table (`quality.aerial_table` 32: effects/daytime/docs/
+   default), through the aerial table (`quality.aerial_table` 16: effects/daytime/docs/
    aerial_table.md), for brute-force marching of the same field (`"airlight": "march"`: the
    source sampled at every step instead of integrated over scattering volumes), and for single
    scattering alone (`quality.multiple_scattering` false: what the renderer gave before).
@@ -46,7 +46,7 @@ import ms_cases  # noqa: E402
 def accuracy(march_steps: list[int]) -> tuple[list[str], dict]:
     cases = ms_cases.load_cases("day")["cases"]
     renderer = airlight.Renderer("cpu")
-    methods = [("volumes", {}), ("aerial table 32", {"aerial_table": 32}),
+    methods = [("volumes", {"aerial_table": 0}), ("aerial table 16", {"aerial_table": 16}),
                *[(f"march {n}", {"airlight": "march", "march_steps": n}) for n in march_steps],
                ("single only", {"multiple_scattering": False})]
     lines = ["| case | " + " | ".join(f"{m}: within / median / max" for m, _ in methods) + " |",
@@ -156,7 +156,7 @@ def plot(totals: dict, path: Path) -> None:
     import matplotlib.pyplot as plt
 
     fig, ax = plt.subplots(figsize=(6.5, 4.0))
-    for method in ("volumes", "aerial table 32", "single only"):
+    for method in ("volumes", "aerial table 16", "single only"):
         got = np.concatenate([t[0] for t in totals[method]]).ravel()
         want = np.concatenate([t[1] for t in totals[method]]).ravel()
         ax.loglog(want, got, ".", ms=3, label=f"airlight, {method}")
