@@ -290,6 +290,11 @@ airlight::SphereGrid parse_sphere_grid(const py::dict& keys) {
     airlight::SphereGrid grid;
     for (auto item : keys) {
         const std::string key = py::str(item.first);
+        if (key == "beyond") {
+            if (!py::isinstance<py::bool_>(item.second)) throw py::type_error("grid.beyond: must be true or false");
+            grid.beyond = item.second.cast<bool>();
+            continue;
+        }
         int* field = key == "radii"         ? &grid.radii
                      : key == "polar"       ? &grid.polar
                      : key == "zenith"      ? &grid.zenith
@@ -532,7 +537,8 @@ PYBIND11_MODULE(_core, m) {
     // The particle clouds' reference particle (effects/particle_clouds/sphere_scattering.hpp): the
     // radiance of each scattering order along rays (origins and dirs (n, 3); the camera looks along dir)
     // for a unit sphere of optical radius tau lit by a sun of irradiance 1 from direction `sun`, solved
-    // on `grid` (a dict of SphereGrid's fields); an (n, orders) float64 array.
+    // on `grid` (a dict of SphereGrid's fields); an (n, orders) float64 array, (n, orders + 1) with
+    // grid["beyond"] (the last column: every order beyond summed).
     m.def(
         "particle_sphere_radiance",
         [](double tau, double g, std::array<double, 3> sun,
@@ -571,7 +577,8 @@ PYBIND11_MODULE(_core, m) {
                 }
             }
             const py::ssize_t n = origins.shape(0);
-            py::array_t<double> out({n, py::ssize_t(grid.orders)});
+            const py::ssize_t columns = grid.orders + (grid.beyond ? 1 : 0);
+            py::array_t<double> out({n, columns});
             const double* o = origins.data();
             const double* d = dirs.data();
             double* r = out.mutable_data();
@@ -584,7 +591,7 @@ PYBIND11_MODULE(_core, m) {
                     throw py::value_error("dirs: every row must be a nonzero finite vector");
                 for (double& x : dd) x /= len;
                 const std::vector<double> orders = solved->radiance_orders(oo, dd, steps);
-                std::copy(orders.begin(), orders.end(), r + i * grid.orders);
+                std::copy(orders.begin(), orders.end(), r + i * columns);
             }
             return out;
         },

@@ -71,6 +71,7 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
 ParticleTableShape particle_table_shape(ParticleTableQuality quality) {
     ParticleTableShape shape;  // full: 12 optical radii (effects/particle_clouds/docs/table_resolution.txt)
     shape.taus = 12;
+    shape.grid.beyond = true;  // every order, not the source's 18 (physics.md section 2.7)
     if (quality == ParticleTableQuality::preview) {
         shape.entry = 16;
         shape.view_zenith = 8;

@@ -97,6 +97,12 @@ struct SphereScattering::Impl {
     // The orders >= 2 summed, for single_and_multiple: sum_k R_k on the grid and e_k by position.
     std::vector<float> rest_sum;
     std::vector<float> peaks;  // [position][k - 2]
+    // Every order beyond grid.orders summed (eq. 2.11; its peak 0, on the grid whole), when grid.beyond.
+    OrderSource beyond{{}, {}, 0.0};
+    int beyond_iterations = 0;
+    double beyond_residual = 0.0;
+    static constexpr double kBeyondTolerance = 1e-4;
+    static constexpr int kBeyondIterations = 200;  // tau = 50 takes 32-48
 
     Impl(double tau_, double g_, const SphereGrid& grid_) : tau(tau_), g(g_), grid(grid_), radial(grid_.radii, tau_) {
         dirs = grid.zenith * grid.azimuth;
@@ -224,6 +230,18 @@ struct SphereScattering::Impl {
         return std::fabs(l) < 1e-3 ? 0.5 * (a + b) * (1.0 - l * l / 12.0) : (b - a) / l;
     }
 
+    // Eq. 2.12: the weights of a source's values at t_a and t_b (linear between them) in the integral of
+    // source times e^{-tau t} over [t_a, t_b]: e^{-tau t_a} (A - B, B) with x = tau h, A = (1 - e^{-x}) / tau
+    // and B = (1 - e^{-x} (1 + x)) / (tau x) (its series below x = 1e-2, where the difference cancels).
+    std::array<double, 2> linear_step_weights(double t_a, double t_b) const {
+        const double h = t_b - t_a, x = tau * h, e = std::exp(-tau * t_a);
+        if (!(h > 0.0)) return {0.0, 0.0};
+        const double a = -std::expm1(-x) / tau;
+        const double b = x < 1e-2 ? h * (0.5 - x / 3.0 + x * x / 8.0 - x * x * x / 30.0)
+                                  : (-std::expm1(-x) - x * std::exp(-x)) / (tau * x);
+        return {e * (a - b), e * b};
+    }
+
     // The fraction of the light that a ray from radius r at zenith angle zeta (from the outward normal)
     // meets inside the sphere: U = 1 - e^{-tau d(r, zeta)} (eq. 2.10).
     double meets(double r, double zeta) const {
@@ -316,8 +334,12 @@ struct SphereScattering::Impl {
         });
         for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{0, {0, 0, 0, 0}, 0.0f};
     }
-    // Eq. 2.6 over planned samples of the ray whose direction has sun . w = cos_sun.
-    double planned_march(const PlannedSample* samples, const OrderSource& o, double cos_sun) const {
+    // Eq. 2.6 over planned samples of the ray whose direction has sun . w = cos_sun. With `linear`, the
+    // source is linear between samples instead, its product with the exact exponential integrated
+    // (eq. 2.12): linear in the source, as the Krylov solve of the orders beyond needs (eq. 2.11); the
+    // logarithmic mean is not additive, and a Krylov vector changes sign.
+    double planned_march(const PlannedSample* samples, const OrderSource& o, double cos_sun,
+                         bool linear = false) const {
         const double peak_phase = hg_of(o.peak_g, cos_sun);
         const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
         double sum = 0.0, f_prev = 0.0, t_prev = 0.0;
@@ -340,6 +362,16 @@ struct SphereScattering::Impl {
             const double peak =
                 (1 - frac[0]) * ((1 - frac[1]) * o.peak[position] + frac[1] * o.peak[position + 1]) +
                 frac[0] * ((1 - frac[1]) * o.peak[position + grid.polar] + frac[1] * o.peak[position + grid.polar + 1]);
+            if (linear) {
+                const double j = peak * peak_phase + rest;
+                if (i > 0) {
+                    const std::array<double, 2> w = linear_step_weights(t_prev, double(s.t));
+                    sum += w[0] * f_prev + w[1] * j;
+                }
+                f_prev = j;
+                t_prev = s.t;
+                continue;
+            }
             const double f = (peak * peak_phase + rest) * std::exp(-tau * double(s.t));
             if (i > 0) sum += (double(s.t) - t_prev) * log_mean(f_prev, f);
             f_prev = f;
@@ -348,14 +380,18 @@ struct SphereScattering::Impl {
         return sum;
     }
 
+    // I_k at the nodes ([position][direction]) and toward the sun at each position node.
+    struct NodeRadiance {
+        std::vector<float> radiance, toward_sun;
+    };
+
     void solve() {
         const GatherWeights weights = gather_weights();
         std::vector<double> node_meets(size_t(grid.radii) * grid.zenith);  // U at each radius and zenith node
         for (int ir = 0; ir < grid.radii; ++ir)
             for (int k = 0; k < grid.zenith; ++k)
                 node_meets[size_t(ir) * grid.zenith + k] = meets(radial.radius(ir), zenith_angle(k));
-        std::vector<float> radiance(size_t(positions) * dirs);  // I_k at the nodes
-        std::vector<float> toward_sun(positions);               // I_k(y, sun) at the position nodes
+        NodeRadiance light{std::vector<float>(size_t(positions) * dirs), std::vector<float>(positions)};
         const Vec sun{0.0, 0.0, 1.0};
         // Every node ray's samples, located once (rays [position][direction], then one toward the sun
         // per position): the march of orders >= 2 reads them.
@@ -372,22 +408,24 @@ struct SphereScattering::Impl {
             const Vec y = node_position(p);
             for (int d = 0; d < dirs; ++d) {
                 const Vec w = node_direction(p, d);
-                radiance[size_t(p) * dirs + d] =
+                light.radiance[size_t(p) * dirs + d] =
                     float(march(y, w, grid.march_steps, [&](const Vec& x) { return single_source(x, w); }));
             }
-            toward_sun[p] = float(march(y, sun, grid.march_steps, [&](const Vec& x) { return single_source(x, sun); }));
+            light.toward_sun[p] =
+                float(march(y, sun, grid.march_steps, [&](const Vec& x) { return single_source(x, sun); }));
         });
-        double peak_g = g;  // g^k: I_k's forward peak is shaped like p_{g^k} (the k-fold convolution of p)
-        for (int order = 2; order <= grid.orders; ++order) {
-            // Eq. 2.9: gather the previous order's radiance into this order's source, its peak toward the
-            // sun c p_{g^k} taken out and gathered exactly (p * p_{g^k} = p_{g^{k+1}}).
+        // Eq. 2.9: gather the radiance `in` of one order (made by the source `made_by`, order 1's analytic
+        // source when null) into the next order's source. With split_peak its peak toward the sun,
+        // c p_{g^k} with g^k = peak_g, is taken out and gathered exactly (p * p_{g^k} = p_{g^{k+1}});
+        // without, everything goes through the grid (the orders beyond, eq. 2.11).
+        auto gather = [&](const NodeRadiance& in, const OrderSource* made_by, double peak_g, bool split_peak) {
             OrderSource next{std::vector<float>(positions), std::vector<float>(size_t(positions) * dirs, 0.0f),
-                             peak_g * g};
+                             split_peak ? peak_g * g : 0.0};
             numerics::parallel_for(positions, [&](int p) {
-                const double c = toward_sun[p] / hg_of(peak_g, 1.0);
+                const double c = split_peak ? in.toward_sun[p] / hg_of(peak_g, 1.0) : 0.0;
                 next.peak[p] = float(tau * c);
                 float* out = &next.rest[size_t(p) * dirs];
-                const float* in = &radiance[size_t(p) * dirs];
+                const float* radiance = &in.radiance[size_t(p) * dirs];
                 const int ir = p / grid.polar;
                 const float* weighted = &weights.by_radius[size_t(ir) * dirs * dirs];
                 const Vec y = node_position(p);
@@ -395,27 +433,34 @@ struct SphereScattering::Impl {
                     // Eq. 2.10: I = U S with S smooth (the mean source along the ray; at U = 0 the source at y).
                     const double u = node_meets[size_t(ir) * grid.zenith + j / grid.azimuth];
                     const Vec w = node_direction(p, j);
-                    const double mean = u > 1e-7     ? in[j] / u
-                                        : order == 2 ? single_source(y, w) / tau
-                                                     : order_source(source.back(), y, w) / tau;
+                    const double mean = u > 1e-7  ? radiance[j] / u
+                                        : made_by ? order_source(*made_by, y, w) / tau
+                                                  : single_source(y, w) / tau;
                     const float a = float(tau * mean), b = float(-tau * c * hg_of(peak_g, w.z));
                     const float* column = &weighted[size_t(j) * dirs];
                     const float* plain = &weights.plain[size_t(j) * dirs];
                     for (int i = 0; i < dirs; ++i) out[i] += a * column[i] + b * plain[i];
                 }
             });
-            peak_g *= g;
-            source.push_back(std::move(next));
-            if (order == grid.orders) break;
-            // Eq. 2.4: this order's radiance at the nodes, marching its source.
-            const OrderSource& field = source.back();
+            return next;
+        };
+        // Eq. 2.4: an order's radiance at the nodes, marching its source.
+        auto march_nodes = [&](const OrderSource& field, NodeRadiance& out, bool linear) {
             numerics::parallel_for(positions, [&](int p) {
                 const PlannedSample* ray = &plan[size_t(p) * (dirs + 1) * per_ray];
                 for (int d = 0; d < dirs; ++d)
-                    radiance[size_t(p) * dirs + d] =
-                        float(planned_march(ray + d * per_ray, field, node_direction(p, d).z));
-                toward_sun[p] = float(planned_march(ray + dirs * per_ray, field, 1.0));
+                    out.radiance[size_t(p) * dirs + d] =
+                        float(planned_march(ray + d * per_ray, field, node_direction(p, d).z, linear));
+                out.toward_sun[p] = float(planned_march(ray + dirs * per_ray, field, 1.0, linear));
             });
+        };
+        double peak_g = g;  // g^k: I_k's forward peak is shaped like p_{g^k} (the k-fold convolution of p)
+        for (int order = 2; order <= grid.orders; ++order) {
+            OrderSource next = gather(light, order == 2 ? nullptr : &source.back(), peak_g, true);
+            peak_g *= g;
+            source.push_back(std::move(next));
+            if (order == grid.orders && !grid.beyond) break;
+            march_nodes(source.back(), light, false);
         }
         rest_sum.assign(size_t(positions) * dirs, 0.0f);
         peaks.assign(size_t(positions) * source.size(), 0.0f);
@@ -423,6 +468,101 @@ struct SphereScattering::Impl {
             for (size_t i = 0; i < rest_sum.size(); ++i) rest_sum[i] += source[k].rest[i];
             for (int p = 0; p < positions; ++p) peaks[size_t(p) * source.size() + k] = source[k].peak[p];
         }
+        if (!grid.beyond) return;
+        // Eq. 2.11: the orders beyond, B = sum_{k > N} J_k, solve (1 - K) B = J_{N+1}, K one gather of one
+        // march on the grid. J_{N+1} comes from order N's radiance with its peak split off as before, then
+        // goes onto the grid whole (its lobe p_{g^{N+1}} is broad by then: g^19 <= 0.15 for g <= 0.9).
+        const OrderSource first = gather(light, source.empty() ? nullptr : &source.back(), peak_g, true);
+        std::vector<double> rhs(size_t(positions) * dirs);
+        for (int p = 0; p < positions; ++p)
+            for (int d = 0; d < dirs; ++d)
+                rhs[size_t(p) * dirs + d] = first.rest[size_t(p) * dirs + d] +
+                                            double(first.peak[p]) * hg_of(first.peak_g, node_direction(p, d).z);
+        OrderSource field{std::vector<float>(positions, 0.0f), std::vector<float>(rhs.size()), 0.0};
+        // x -> (1 - K) x.
+        auto apply = [&](const std::vector<double>& x, std::vector<double>& out) {
+            for (size_t i = 0; i < x.size(); ++i) field.rest[i] = float(x[i]);
+            march_nodes(field, light, true);
+            const OrderSource gathered = gather(light, &field, 0.0, false);
+            for (size_t i = 0; i < x.size(); ++i) out[i] = x[i] - double(gathered.rest[i]);
+        };
+        const std::vector<double> solution = gmres(apply, rhs);
+        field.rest.assign(solution.begin(), solution.end());
+        beyond = std::move(field);
+        for (size_t i = 0; i < rest_sum.size(); ++i) rest_sum[i] += beyond.rest[i];
+    }
+
+    // GMRES (Saad and Schultz 1986; Arnoldi with modified Gram-Schmidt, Givens rotations) for M x = b,
+    // M given by apply(x, out), from x = 0: stops at a residual of kBeyondTolerance |b| or after
+    // kBeyondIterations (the basis is kept whole: 2 MiB a vector at the default grid). M = 1 - K has its eigenvalues in
+    // (0, 2): K loses a little light each order, least in the slowest modes of a thick sphere (about pi^2 / (3 tau^2 (1
+    // - g)) of it, the diffusion limit), which plain iteration would take thousands of orders to sum and a Krylov
+    // method about the square root of that (physics.md section 2.7).
+    template <class Apply>
+    std::vector<double> gmres(const Apply& apply, const std::vector<double>& b) {
+        const size_t n = b.size();
+        const int m = kBeyondIterations;
+        auto norm = [](const std::vector<double>& x) {
+            double s = 0.0;
+            for (double v : x) s += v * v;
+            return std::sqrt(s);
+        };
+        const double b_norm = norm(b);
+        beyond_iterations = 0;
+        beyond_residual = 0.0;
+        std::vector<double> x(n, 0.0);
+        if (!(b_norm > 0.0)) return x;
+        std::vector<std::vector<double>> basis;
+        std::vector<std::vector<double>> h;  // Hessenberg columns, rotated into R
+        std::vector<double> cs, sn, rhs{b_norm};
+        basis.emplace_back(n);
+        for (size_t i = 0; i < n; ++i) basis[0][i] = b[i] / b_norm;
+        std::vector<double> v(n), w(n);
+        int k = 0;
+        for (; k < m; ++k) {
+            for (size_t i = 0; i < n; ++i) v[i] = basis[k][i];
+            apply(v, w);
+            std::vector<double> col(k + 2, 0.0);
+            for (int j = 0; j <= k; ++j) {  // modified Gram-Schmidt
+                double d = 0.0;
+                for (size_t i = 0; i < n; ++i) d += w[i] * basis[j][i];
+                col[j] = d;
+                for (size_t i = 0; i < n; ++i) w[i] -= d * basis[j][i];
+            }
+            col[k + 1] = norm(w);
+            for (int j = 0; j < k; ++j) {  // the earlier rotations
+                const double a = cs[j] * col[j] + sn[j] * col[j + 1];
+                col[j + 1] = -sn[j] * col[j] + cs[j] * col[j + 1];
+                col[j] = a;
+            }
+            const double r = std::hypot(col[k], col[k + 1]);
+            cs.push_back(r > 0.0 ? col[k] / r : 1.0);
+            sn.push_back(r > 0.0 ? col[k + 1] / r : 0.0);
+            const double next_norm = col[k + 1];
+            col[k] = r;
+            col[k + 1] = 0.0;
+            h.push_back(col);
+            rhs.push_back(-sn[k] * rhs[k]);
+            rhs[k] *= cs[k];
+            beyond_residual = std::fabs(rhs[k + 1]) / b_norm;
+            if (beyond_residual <= kBeyondTolerance || !(next_norm > 0.0)) {
+                ++k;
+                break;
+            }
+            basis.emplace_back(n);
+            for (size_t i = 0; i < n; ++i) basis[k + 1][i] = w[i] / next_norm;
+        }
+        beyond_iterations = std::min(k, m);
+        // x = V y, R y = rhs (back substitution).
+        std::vector<double> y(beyond_iterations, 0.0);
+        for (int j = beyond_iterations - 1; j >= 0; --j) {
+            double s = rhs[j];
+            for (int l = j + 1; l < beyond_iterations; ++l) s -= h[l][j] * y[l];
+            y[j] = s / h[j][j];
+        }
+        for (int j = 0; j < beyond_iterations; ++j)
+            for (size_t i = 0; i < n; ++i) x[i] += y[j] * basis[j][i];
+        return x;
     }
 };
 
@@ -439,6 +579,8 @@ SphereScattering::~SphereScattering() = default;
 double SphereScattering::tau() const { return impl_->tau; }
 double SphereScattering::g() const { return impl_->g; }
 const SphereGrid& SphereScattering::grid() const { return impl_->grid; }
+int SphereScattering::beyond_iterations() const { return impl_->beyond_iterations; }
+double SphereScattering::beyond_residual() const { return impl_->beyond_residual; }
 
 // The ray's entry point into the unit sphere (origin outside or on it), false when it misses.
 static bool sphere_entry(const Vec& o, const Vec& v, Vec& entry) {
@@ -471,14 +613,14 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     };
     if (orders >= 1) out[1] = peak_integral(0);
     if (orders >= 2) out[2] = peak_integral(1);
-    if (orders == 0) return out;
+    if (orders == 0 && !impl_->grid.beyond) return out;
     // The rest of orders >= 2 at once: the rests' sum and the peaks of orders >= 4.
     std::vector<double> peak_phase(orders, 0.0);
     for (size_t k = 2; k < orders; ++k) peak_phase[k] = Impl::hg_of(impl_->source[k].peak_g, v.z);
     out[3] = impl_->march(entry, v, steps, [&](const Vec& x) {
         const GridPoint p = impl_->locate(x, v);
         auto peak_at = [&](int position) {
-            const float* e = &impl_->peaks[size_t(position) * orders];
+            const float* e = impl_->peaks.data() + size_t(position) * orders;
             double sum = 0.0;
             for (size_t k = 2; k < orders; ++k) sum += e[k] * peak_phase[k];
             return sum;
@@ -493,7 +635,7 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
 }
 
 std::vector<double> SphereScattering::radiance_orders(const double origin[3], const double dir[3], int steps) const {
-    std::vector<double> out(size_t(impl_->grid.orders), 0.0);
+    std::vector<double> out(size_t(impl_->grid.orders) + (impl_->grid.beyond ? 1 : 0), 0.0);
     const Vec o{origin[0], origin[1], origin[2]}, v{dir[0], dir[1], dir[2]};
     Vec entry;
     if (!sphere_entry(o, v, entry)) return out;
@@ -502,6 +644,9 @@ std::vector<double> SphereScattering::radiance_orders(const double origin[3], co
         const Impl::OrderSource& field = impl_->source[k];
         out[k + 1] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->order_source(field, x, v); });
     }
+    if (impl_->grid.beyond)
+        out.back() =
+            impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->order_source(impl_->beyond, x, v); });
     return out;
 }
 

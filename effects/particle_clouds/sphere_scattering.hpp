@@ -19,7 +19,11 @@ struct SphereGrid {
     int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
     int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
     int march_steps = 16;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
-    int orders = 18;       // scattering orders solved (the source sums 18)
+    int orders = 18;       // scattering orders solved one by one (the source sums 18)
+    // Also solve the sum of every order beyond `orders` at once (eq. 2.11): a thick particle's light
+    // still inside after 18 orders is 19-60 % of what it scatters (effects/particle_clouds/physics.md
+    // section 2.7). Off, the orders stop at `orders`, as in the source.
+    bool beyond = false;
 };
 
 // Throws std::invalid_argument naming the field when a resolution is out of range.
@@ -38,17 +42,23 @@ public:
 
     // The radiance of each order 1..orders that a camera looking along `dir`
     // (unit) from `origin` receives from the sphere (0 for a ray that misses
-    // it), the ray integral taken with `steps` steps (eq. 2.4).
+    // it), the ray integral taken with `steps` steps (eq. 2.4); with
+    // grid.beyond one more entry, the radiance of all orders beyond.
     std::vector<double> radiance_orders(const double origin[3], const double dir[3], int steps) const;
     // What the particle table stores for the same ray (physics.md eq. 3.1): order 1 over its phase
     // p_g(sun . v); the ray integrals of orders 2 and 3's peak coefficients (eq. 2.8), whose phases
     // p_{g^2}, p_{g^3} are the same all along the ray; and the rest of orders 2..orders (their R_k and
-    // the peaks of orders >= 4) in one march. Radiance = c0 p_g + c1 p_{g^2} + c2 p_{g^3} + c3.
+    // the peaks of orders >= 4) in one march, with every order beyond when grid.beyond is set. Radiance = c0 p_g + c1
+    // p_{g^2} + c2 p_{g^3} + c3.
     std::array<double, 4> table_channels(const double origin[3], const double dir[3], int steps) const;
 
     double tau() const;
     double g() const;
     const SphereGrid& grid() const;
+    // The sum of the orders beyond grid.orders (eq. 2.11): Krylov iterations taken (0 when not solved)
+    // and the relative residual reached.
+    int beyond_iterations() const;
+    double beyond_residual() const;
 
 private:
     struct Impl;
