@@ -83,8 +83,8 @@ from test_sphere_scattering import SUN, orthographic_rays  # noqa: E402
 
 ORDERS = 18  # the source's orders; Mitsuba's max_depth ORDERS + 1 is their sum
 RADIUS = 100.0  # the sphere's radius in Mitsuba's world (module docstring)
-DEPTHS = [2, 3, 4, ORDERS + 1]
-COLUMNS = ["k=1", "k=2", "k=3", f"sum{ORDERS}"]
+DEPTHS = [2, 3, 4, ORDERS + 1, -1]  # -1: unlimited, every order
+COLUMNS = ["k=1", "k=2", "k=3", f"sum{ORDERS}", "total"]
 FLOOR = 1e-3  # rays below this fraction of the case's largest Mitsuba value (per order) are left out
 REL_TOL, Z_TOL = 0.02, 3.0  # the acceptance: |difference| <= max(2 %, 3 standard errors)
 
@@ -130,13 +130,16 @@ def sweep_rays() -> tuple[np.ndarray, np.ndarray, list[str]]:
 
 
 def solver_by_order(tau: float, g: float, origins: np.ndarray, dirs: np.ndarray, steps: int) -> np.ndarray:
-    """The solver's radiance (n_rays, ORDERS), one call (the default grid)."""
-    return airlight._core.particle_sphere_radiance(tau, g, SUN, origins, dirs, {"orders": ORDERS}, steps)
+    """The solver's radiance (n_rays, ORDERS + 1): orders 1..ORDERS and every order beyond (eq. 2.11),
+    one call (the default grid)."""
+    grid = {"orders": ORDERS, "beyond": True}
+    return airlight._core.particle_sphere_radiance(tau, g, SUN, origins, dirs, grid, steps)
 
 
 def mitsuba_columns(tau: float, g: float, origins: np.ndarray, dirs: np.ndarray, spp: int, seed: int,
                     chunks: int) -> tuple[np.ndarray, np.ndarray, float]:
-    """Mitsuba's orders 1, 2, 3 and the sum of 1..ORDERS (means, standard errors: (n_rays, 4)) and
+    """Mitsuba's orders 1, 2, 3, the sum of 1..ORDERS and every order (means, standard errors:
+    (n_rays, 5)) and
     the seconds spent. Each ray is rendered with its own seed (``seed`` + its index): the harness seeds
     every origin alike, which would give all rays the same random numbers and make their errors move
     together (a case's median error would then be one draw of the noise, not an average)."""
@@ -147,7 +150,7 @@ def mitsuba_columns(tau: float, g: float, origins: np.ndarray, dirs: np.ndarray,
                                         seed + i, RADIUS)
         seconds += sum(sec.values())
         cols.append([sm._stats(means[2]), sm._stats(means[3] - means[2]), sm._stats(means[4] - means[3]),
-                     sm._stats(means[ORDERS + 1])])
+                     sm._stats(means[ORDERS + 1]), sm._stats(means[-1])])
     mean = np.array([[float(m[0]) for m, _ in row] for row in cols])
     se = np.array([[float(e[0]) for _, e in row] for row in cols])
     return mean, se, seconds
@@ -181,7 +184,7 @@ def plot(path: str, points: list[Point], cases: list[str]) -> None:
     matplotlib.use("Agg")
     import matplotlib.pyplot as plt
 
-    colours = ["tab:blue", "tab:orange", "tab:green", "tab:red"]
+    colours = ["tab:blue", "tab:orange", "tab:green", "tab:red", "tab:purple"]
     fig, (ax0, ax1) = plt.subplots(1, 2, figsize=(15, 6.5))
     lo = min(float(ref.min()) for _, _, _, ref, _ in points)  # compared rays are above the floor, so > 0
     for c, name in enumerate(COLUMNS):
@@ -201,7 +204,7 @@ def plot(path: str, points: list[Point], cases: list[str]) -> None:
     ax0.legend()
     for case, col, mine, ref, se in points:
         rel = 100.0 * (mine / ref - 1.0)
-        x = case + (col - 1.5) * 0.18 + np.linspace(-0.06, 0.06, len(rel))
+        x = case + (col - 2.0) * 0.16 + np.linspace(-0.05, 0.05, len(rel))
         ax1.errorbar(x, np.clip(rel, -20.0, 20.0), yerr=100.0 * Z_TOL * se / ref, fmt="o", ms=2.5,
                      elinewidth=0.6, color=colours[col], alpha=0.7)
     ax1.axhspan(-100 * REL_TOL, 100 * REL_TOL, color="0.85", zorder=0)
@@ -238,7 +241,8 @@ def main() -> None:
     mi = sm.load(args.threads, args.libllvm)
     origins, dirs, labels = sweep_rays()
     lines = [
-        f"Solver (airlight particle_sphere_radiance, default grid, {ORDERS} orders, {args.steps} samples "
+        f"Solver (airlight particle_sphere_radiance, default grid, {ORDERS} orders and every order beyond, "
+        f"{args.steps} samples "
         f"per camera ray) against Mitsuba {mi.__version__} volpath ({mi.variant()}, sphere radius "
         f"{RADIUS:g} in its world, {args.spp} samples per ray and max_depth in {args.chunks} batch means, "
         "common random numbers)",
@@ -263,7 +267,8 @@ def main() -> None:
         t = time.perf_counter()
         mine_k = solver_by_order(tau, g, origins, dirs, args.steps)
         t_solver += time.perf_counter() - t
-        mine = np.concatenate([mine_k[:, :3], mine_k.sum(axis=1, keepdims=True)], axis=1)
+        mine = np.concatenate([mine_k[:, :3], mine_k[:, :ORDERS].sum(axis=1, keepdims=True),
+                               mine_k.sum(axis=1, keepdims=True)], axis=1)
         seed = args.seed + 1000 * i_case
         ref, se, sec = mitsuba_columns(tau, g, origins, dirs, args.spp, seed, args.chunks)
         t_mitsuba += sec
