@@ -140,30 +140,91 @@ struct SphereScattering::Impl {
                           p.node[3], p.frac[3]);
         return p;
     }
-    // Quadrilinear interpolation of a field on the grid.
-    double interpolate(const std::vector<float>& field, const GridPoint& p) const {
-        const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
-        const int base = p.node[0] * stride[0] + p.node[1] * stride[1] + p.node[2] * stride[2] + p.node[3];
-        double sum = 0.0;
-        for (int corner = 0; corner < 16; ++corner) {
-            double weight = 1.0;
-            int index = base;
-            for (int axis = 0; axis < 4; ++axis) {
-                const bool upper = (corner >> axis) & 1;
-                weight *= upper ? p.frac[axis] : 1.0 - p.frac[axis];
-                index += upper ? stride[axis] : 0;
+    // Eq. 2.13: the position nodes around a grid point and their weights, a Catmull-Rom cubic in the
+    // radial index and in the polar angle. Not linear: a linear interpolant's kinks act as extra
+    // diffusion in a thick particle (physics.md section 2.3). Past a pole the mirror node stands in,
+    // past the centre the missing node is continued linearly.
+    struct PositionTaps {
+        int count = 0;
+        std::array<int, 16> position;
+        std::array<double, 16> weight;
+    };
+    static int cubic_taps(int node, double f, int n, bool mirror, std::array<int, 4>& index,
+                          std::array<double, 4>& weight) {
+        const double f2 = f * f, f3 = f2 * f;
+        std::array<double, 4> w{0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2), 0.5 * (-3 * f3 + 4 * f2 + f),
+                                0.5 * (f3 - f2)};
+        std::array<int, 4> at{node - 1, node, node + 1, node + 2};
+        if (at[0] < 0) {
+            if (mirror) {
+                at[0] = std::min(1, n - 1);
+            } else {  // a = 2 b - c
+                w[1] += 2.0 * w[0];
+                w[2] -= w[0];
+                w[0] = 0.0;
             }
-            if (weight != 0.0) sum += weight * field[index];
         }
+        if (at[3] > n - 1) {
+            if (mirror) {
+                at[3] = std::max(0, n - 2);
+            } else {  // d = 2 c - b
+                w[2] += 2.0 * w[3];
+                w[1] -= w[3];
+                w[3] = 0.0;
+            }
+        }
+        int count = 0;
+        for (int i = 0; i < 4; ++i)
+            if (w[i] != 0.0) {
+                index[count] = at[i];
+                weight[count++] = w[i];
+            }
+        return count;
+    }
+    PositionTaps position_taps(int node_r, double frac_r, int node_p, double frac_p) const {
+        std::array<int, 4> ri, pi;
+        std::array<double, 4> rw, pw;
+        const int nr = cubic_taps(node_r, frac_r, grid.radii, false, ri, rw);
+        const int np = cubic_taps(node_p, frac_p, grid.polar, true, pi, pw);
+        PositionTaps taps;
+        for (int a = 0; a < nr; ++a)
+            for (int b = 0; b < np; ++b) {
+                const double weight = rw[a] * pw[b];
+                if (weight == 0.0) continue;
+                taps.position[taps.count] = ri[a] * grid.polar + pi[b];
+                taps.weight[taps.count++] = weight;
+            }
+        return taps;
+    }
+    // A field on the grid ([position][direction]) at the taps, bilinear in the direction (zenith, azimuth
+    // nodes and fractions).
+    double interpolate(const std::vector<float>& field, const PositionTaps& taps, int zenith_node, double zenith_frac,
+                       int azimuth_node, double azimuth_frac) const {
+        const int d = zenith_node * grid.azimuth + azimuth_node;
+        const double w00 = (1 - zenith_frac) * (1 - azimuth_frac), w01 = (1 - zenith_frac) * azimuth_frac,
+                     w10 = zenith_frac * (1 - azimuth_frac), w11 = zenith_frac * azimuth_frac;
+        double sum = 0.0;
+        for (int i = 0; i < taps.count; ++i) {
+            const float* f = &field[size_t(taps.position[i]) * dirs + d];
+            sum += taps.weight[i] * (w00 * f[0] + w01 * f[1] + w10 * f[grid.azimuth] + w11 * f[grid.azimuth + 1]);
+        }
+        return sum;
+    }
+    double interpolate(const std::vector<float>& field, const GridPoint& p) const {
+        return interpolate(field, position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]), p.node[2], p.frac[2],
+                           p.node[3], p.frac[3]);
+    }
+    // A field by position only (a peak coefficient) at the taps.
+    static double interpolate(const float* by_position, const PositionTaps& taps) {
+        double sum = 0.0;
+        for (int i = 0; i < taps.count; ++i) sum += taps.weight[i] * by_position[taps.position[i]];
         return sum;
     }
     // J_k at grid point p toward an observer looking along w, from its grid (eq. 2.8).
     double order_source(const OrderSource& o, const GridPoint& p, const Vec& w) const {
-        const int base = p.node[0] * grid.polar + p.node[1];
-        const double f0 = p.frac[0], f1 = p.frac[1];
-        const double peak = (1 - f0) * ((1 - f1) * o.peak[base] + f1 * o.peak[base + 1]) +
-                            f0 * ((1 - f1) * o.peak[base + grid.polar] + f1 * o.peak[base + grid.polar + 1]);
-        return peak * hg_of(o.peak_g, w.z) + interpolate(o.rest, p);
+        const PositionTaps taps = position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
+        return interpolate(o.peak.data(), taps) * hg_of(o.peak_g, w.z) +
+               interpolate(o.rest, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
     double order_source(const OrderSource& o, const Vec& x, const Vec& w) const {
         return order_source(o, locate(x, w), w);
@@ -313,10 +374,10 @@ struct SphereScattering::Impl {
     }
 
     // A sample of a node ray located on the grid once, for every order's march (eq. 2.6): the grid
-    // cell (its lower corner's flat index and the fractions toward the next node, 1/65535 steps) and
-    // the distance t along the ray.
+    // cell (its lower node and the fraction toward the next, 1/65535 steps, per axis r, polar, zenith,
+    // azimuth) and the distance t along the ray.
     struct PlannedSample {
-        int32_t base;
+        int16_t node[4];
         uint16_t frac[4];
         float t;
     };
@@ -324,15 +385,16 @@ struct SphereScattering::Impl {
     // Fills the samples of the ray from y along w (all with t = 0 when the ray leaves at once).
     void plan_ray(const Vec& y, const Vec& w, PlannedSample* out) const {
         int n = 0;
-        const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
         march_points(y, w, grid.march_steps, [&](double t) {
             const GridPoint p = locate(y + t * w, w);
             PlannedSample& s = out[n++];
-            s.base = p.node[0] * stride[0] + p.node[1] * stride[1] + p.node[2] * stride[2] + p.node[3];
-            for (int axis = 0; axis < 4; ++axis) s.frac[axis] = uint16_t(std::lround(p.frac[axis] * 65535.0));
+            for (int axis = 0; axis < 4; ++axis) {
+                s.node[axis] = int16_t(p.node[axis]);
+                s.frac[axis] = uint16_t(std::lround(p.frac[axis] * 65535.0));
+            }
             s.t = float(t);
         });
-        for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{0, {0, 0, 0, 0}, 0.0f};
+        for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{{0, 0, 0, 0}, {0, 0, 0, 0}, 0.0f};
     }
     // Eq. 2.6 over planned samples of the ray whose direction has sun . w = cos_sun. With `linear`, the
     // source is linear between samples instead, its product with the exact exponential integrated
@@ -341,29 +403,15 @@ struct SphereScattering::Impl {
     double planned_march(const PlannedSample* samples, const OrderSource& o, double cos_sun,
                          bool linear = false) const {
         const double peak_phase = hg_of(o.peak_g, cos_sun);
-        const int stride[4] = {grid.polar * dirs, dirs, grid.azimuth, 1};
         double sum = 0.0, f_prev = 0.0, t_prev = 0.0;
         for (int i = 0; i < samples_per_ray(); ++i) {
             const PlannedSample& s = samples[i];
             double frac[4];
             for (int axis = 0; axis < 4; ++axis) frac[axis] = s.frac[axis] / 65535.0;
-            double rest = 0.0;
-            for (int corner = 0; corner < 16; ++corner) {
-                double weight = 1.0;
-                int index = s.base;
-                for (int axis = 0; axis < 4; ++axis) {
-                    const bool upper = (corner >> axis) & 1;
-                    weight *= upper ? frac[axis] : 1.0 - frac[axis];
-                    index += upper ? stride[axis] : 0;
-                }
-                rest += weight * o.rest[index];
-            }
-            const int position = s.base / dirs;
-            const double peak =
-                (1 - frac[0]) * ((1 - frac[1]) * o.peak[position] + frac[1] * o.peak[position + 1]) +
-                frac[0] * ((1 - frac[1]) * o.peak[position + grid.polar] + frac[1] * o.peak[position + grid.polar + 1]);
+            const PositionTaps taps = position_taps(s.node[0], frac[0], s.node[1], frac[1]);
+            const double j = interpolate(o.peak.data(), taps) * peak_phase +
+                             interpolate(o.rest, taps, s.node[2], frac[2], s.node[3], frac[3]);
             if (linear) {
-                const double j = peak * peak_phase + rest;
                 if (i > 0) {
                     const std::array<double, 2> w = linear_step_weights(t_prev, double(s.t));
                     sum += w[0] * f_prev + w[1] * j;
@@ -372,7 +420,7 @@ struct SphereScattering::Impl {
                 t_prev = s.t;
                 continue;
             }
-            const double f = (peak * peak_phase + rest) * std::exp(-tau * double(s.t));
+            const double f = j * std::exp(-tau * double(s.t));
             if (i > 0) sum += (double(s.t) - t_prev) * log_mean(f_prev, f);
             f_prev = f;
             t_prev = s.t;
@@ -579,8 +627,6 @@ SphereScattering::~SphereScattering() = default;
 double SphereScattering::tau() const { return impl_->tau; }
 double SphereScattering::g() const { return impl_->g; }
 const SphereGrid& SphereScattering::grid() const { return impl_->grid; }
-int SphereScattering::beyond_iterations() const { return impl_->beyond_iterations; }
-double SphereScattering::beyond_residual() const { return impl_->beyond_residual; }
 
 // The ray's entry point into the unit sphere (origin outside or on it), false when it misses.
 static bool sphere_entry(const Vec& o, const Vec& v, Vec& entry) {
@@ -599,16 +645,12 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     // Order 1 over its phase (eq. 2.2: p(sun . v) is the same all along the ray).
     out[0] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->single_source(x, v); }) / impl_->hg(v.z);
     const size_t orders = impl_->source.size();
-    const int polar = impl_->grid.polar;
-    // e_k at x, bilinear in the position (eq. 2.8), for orders k = 2 and 3 by themselves.
+    // e_k at x (eq. 2.8), for orders k = 2 and 3 by themselves.
     auto peak_integral = [&](size_t k) {
         return impl_->march(entry, v, steps, [&](const Vec& x) {
             const GridPoint p = impl_->locate(x, v);
-            const std::vector<float>& e = impl_->source[k].peak;
-            const int base = p.node[0] * polar + p.node[1];
-            const double f0 = p.frac[0], f1 = p.frac[1];
-            return (1 - f0) * ((1 - f1) * e[base] + f1 * e[base + 1]) +
-                   f0 * ((1 - f1) * e[base + polar] + f1 * e[base + polar + 1]);
+            return Impl::interpolate(impl_->source[k].peak.data(),
+                                     impl_->position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]));
         });
     };
     if (orders >= 1) out[1] = peak_integral(0);
@@ -619,17 +661,15 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     for (size_t k = 2; k < orders; ++k) peak_phase[k] = Impl::hg_of(impl_->source[k].peak_g, v.z);
     out[3] = impl_->march(entry, v, steps, [&](const Vec& x) {
         const GridPoint p = impl_->locate(x, v);
-        auto peak_at = [&](int position) {
-            const float* e = impl_->peaks.data() + size_t(position) * orders;
+        const Impl::PositionTaps taps = impl_->position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
+        double peak = 0.0;
+        for (int i = 0; i < taps.count; ++i) {
+            const float* e = impl_->peaks.data() + size_t(taps.position[i]) * orders;
             double sum = 0.0;
             for (size_t k = 2; k < orders; ++k) sum += e[k] * peak_phase[k];
-            return sum;
-        };
-        const int base = p.node[0] * polar + p.node[1];
-        const double f0 = p.frac[0], f1 = p.frac[1];
-        const double peak = (1 - f0) * ((1 - f1) * peak_at(base) + f1 * peak_at(base + 1)) +
-                            f0 * ((1 - f1) * peak_at(base + polar) + f1 * peak_at(base + polar + 1));
-        return peak + impl_->interpolate(impl_->rest_sum, p);
+            peak += taps.weight[i] * sum;
+        }
+        return peak + impl_->interpolate(impl_->rest_sum, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
     });
     return out;
 }

@@ -55,10 +55,6 @@ public:
     double tau() const;
     double g() const;
     const SphereGrid& grid() const;
-    // The sum of the orders beyond grid.orders (eq. 2.11): Krylov iterations taken (0 when not solved)
-    // and the relative residual reached.
-    int beyond_iterations() const;
-    double beyond_residual() const;
 
 private:
     struct Impl;

@@ -3,7 +3,8 @@
     .venv/bin/python effects/particle_clouds/bench/sphere_against_mitsuba.py \\
         [--taus 0.1 1 5 20 50] [--gs 0 0.5 0.9] [--spp 1048576] [--quick] \\
         [--out effects/particle_clouds/docs/sphere_against_mitsuba.txt] \\
-        [--plot effects/particle_clouds/docs/sphere_against_mitsuba.png]
+        [--plot effects/particle_clouds/docs/sphere_against_mitsuba.png] \\
+        [--json effects/particle_clouds/tests/sphere_mitsuba_reference.json]
 
 What it measures. The issue's acceptance for the particle table: against Mitsuba 3's volumetric path
 tracer (a homogeneous HG sphere lit by a directional light), per scattering order and in total, the
@@ -11,18 +12,19 @@ exitant radiance agrees within 2 % (or within the path tracer's noise where that
 optical radii 0.1 to 50, g 0 to 0.9 and every view and sun angle. The table is checked against the
 solver later; this measures the solver against Mitsuba. Per case (tau, g):
 
-* the solver: ``airlight._core.particle_sphere_radiance`` with the default grid and 18 orders, ONE
-  call per case for all rays, ``--steps`` (default 1024) samples per camera ray (physics.md 2.2: the
-  ray march leaves 0.9 % at 256 samples on a ray entering at the terminator of a tau = 50 sphere,
-  0.13 % at 1024; the steps only set the camera rays' march, not the grid);
+* the solver: ``airlight._core.particle_sphere_radiance`` with the default grid, 18 orders and every
+  order beyond (eq. 2.11), ONE call per case for all rays, ``--steps`` (default 1024) samples per
+  camera ray (physics.md 2.2: the ray march leaves 0.9 % at 256 samples on a ray entering at the
+  terminator of a tau = 50 sphere, 0.13 % at 1024; the steps only set the camera rays' march, not
+  the grid);
 * Mitsuba (effects/particle_clouds/bench/sphere_mitsuba.py, whose ``_chunk_means`` and ``_stats``
-  are used): max_depth 2, 3, 4 and 19 rendered with the same seeds and lanes (common random
-  numbers; each ray its own seed), order 1 = L(2) (L(1) is exactly 0), order k = L(k + 1) - L(k)
-  for k = 2, 3, and the sum of orders 1..18 = L(19); standard errors from 16 batch means. The sphere
-  has radius 100 in Mitsuba's world (sigma_t = tau / 100, the harness scales the ray origins by the
-  radius, directions unchanged, so the optical geometry and the radiances are the same as for the
-  unit sphere): its float32 single-scattering deficit at tau = 50 is 0.7 % there against 1.3 % at
-  radius 1 (sphere_mitsuba.py's docstring).
+  are used): max_depth 2, 3, 4, 19 and unlimited rendered with the same seeds and lanes (common
+  random numbers; each ray its own seed), order 1 = L(2) (L(1) is exactly 0), order k = L(k + 1) -
+  L(k) for k = 2, 3, the sum of orders 1..18 = L(19) and the total = L(-1); standard errors from 16
+  batch means. The sphere has radius 100 in Mitsuba's world (sigma_t = tau / 100, the harness scales
+  the ray origins by the radius, directions unchanged, so the optical geometry and the radiances are
+  the same as for the unit sphere): its float32 single-scattering deficit at tau = 50 is 0.7 % there
+  against 1.3 % at radius 1 (sphere_mitsuba.py's docstring).
 
 The rays (the same 25 for every case; ``sweep_rays``): the sun is test_sphere_scattering.SUN
 = (0, 0.6, 0.8); five orthographic views (test_sphere_scattering.orthographic_rays, imported) with
@@ -42,27 +44,23 @@ side, down to 1e-40, which Mitsuba barely samples): the median and the largest r
 (rays where |difference| > max(2 % of Mitsuba, 3 Mitsuba standard errors): the acceptance). Every
 failing ray is listed after the table.
 
-Reading the default run (effects/particle_clouds/docs/sphere_against_mitsuba.txt; a few failing rays
-re-checked by hand against sphere_paths' closed-form single scattering and its float64 path tracer):
-order 1's failures at tau 20 and 50 are Mitsuba's (the solver equals the closed form to 4 digits;
-Mitsuba is 2-12 % low on rays entering where the sun grazes, even at radius 100); the solver's large
-excesses in orders 2, 3 and the sum at tau 20 and 50 (rays entering in the shadow or at the
-terminator, 10-280 %) and at tau 5 (sum, +3-6 %) are the solver's (sphere_paths agrees with
-Mitsuba); at tau 0.1, g 0.9 the failing orders 2 and 3 (radiances near the 1e-3 floor, front- and
-side-lit) agree with sphere_paths, Mitsuba being low there with heavy tails its batch-means error
-misses.
+Reading the run (effects/particle_clouds/docs/sphere_against_mitsuba.txt, --spp 262144; a few failing
+rays re-checked by hand against sphere_paths' closed-form single scattering and its float64 path
+tracer): order 1's failures at tau 20 and 50 are Mitsuba's (the solver equals the closed form to 4
+digits; Mitsuba is 2-12 % low on rays entering where the sun grazes, even at radius 100); at tau 0.1,
+g 0.9 the failing orders 2 and 3 (radiances near the 1e-3 floor, front- and side-lit) agree with
+sphere_paths, Mitsuba being low there with heavy tails its batch-means error misses; the total's
+remaining failures are the solver's (physics.md section 2.6: the shadowed side of tau = 50, g = 0).
 
-Runtime of the default sweep (15 cases, 25 rays, 2^20 samples per ray and max_depth): 9.3 minutes
-on 2 cores shared with another job (load average 4-5; solver 119 s, about 8 s per case for 18
-orders with the solver of commit a434f7b, Mitsuba 431 s, 15-45 s per case, thick spheres slowest);
-the last line of effects/particle_clouds/docs/sphere_against_mitsuba.txt. Mitsuba's time is
-proportional to --spp (2^21 would take about 17 minutes). --quick (tau 5, g 0.5, 65536 samples):
-under a minute.
+Runtime with --spp 262144 (15 cases, 25 rays, five depths): 22.5 minutes on 2 cores shared with a
+test run (solver 591 s, Mitsuba 756 s); the last line of the text file. Mitsuba's time is
+proportional to --spp. --quick (tau 5, g 0.5, 65536 samples): about a minute.
 """
 
 from __future__ import annotations
 
 import argparse
+import json
 import math
 import os
 import sys
@@ -232,6 +230,9 @@ def main() -> None:
     ap.add_argument("--libllvm", default=None, help="libLLVM for Dr.Jit (else DRJIT_LIBLLVM_PATH, or search)")
     ap.add_argument("--out", default=None, help="write the table to this text file")
     ap.add_argument("--plot", default=None, help="write a PNG of solver against Mitsuba")
+    ap.add_argument("--json", default=None,
+                    help="write Mitsuba's means and standard errors per case, column and ray (with the rays) "
+                    "to this file: the stored reference of test_sphere_scattering's thick-sphere test")
     ap.add_argument("--quick", action="store_true", help="tau 5, g 0.5 only, 65536 samples")
     args = ap.parse_args()
     if args.quick:
@@ -263,6 +264,7 @@ def main() -> None:
     cases: list[str] = []
     t_solver = t_mitsuba = 0.0
     totals = {c: [0, 0] for c in COLUMNS}  # rays compared, rays failing
+    stored: list[dict] = []
     for i_case, (tau, g) in enumerate((t, g) for t in args.taus for g in args.gs):
         t = time.perf_counter()
         mine_k = solver_by_order(tau, g, origins, dirs, args.steps)
@@ -273,6 +275,7 @@ def main() -> None:
         ref, se, sec = mitsuba_columns(tau, g, origins, dirs, args.spp, seed, args.chunks)
         t_mitsuba += sec
         cases.append(f"tau {tau:g} g {g:g}")
+        stored.append({"tau": tau, "g": g, "mean": ref.tolist(), "se": se.tolist()})
         for c, name in enumerate(COLUMNS):
             st = compare(mine[:, c], ref[:, c], se[:, c])
             if st["n"] == 0:
@@ -305,6 +308,13 @@ def main() -> None:
     if args.out:
         Path(args.out).parent.mkdir(parents=True, exist_ok=True)
         Path(args.out).write_text("\n".join(lines) + "\n")
+    if args.json:
+        Path(args.json).parent.mkdir(parents=True, exist_ok=True)
+        Path(args.json).write_text(json.dumps({
+            "command": "effects/particle_clouds/bench/sphere_against_mitsuba.py " + " ".join(sys.argv[1:]),
+            "mitsuba": mi.__version__, "variant": mi.variant(), "spp": args.spp, "chunks": args.chunks,
+            "sun": [float(x) for x in SUN], "columns": COLUMNS, "labels": labels,
+            "origins": origins.tolist(), "dirs": dirs.tolist(), "cases": stored}) + "\n")
     if args.plot and points:
         plot(args.plot, points, cases)
 

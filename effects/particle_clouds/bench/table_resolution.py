@@ -1,7 +1,7 @@
 """The particle lighting table's resolution chosen by its error against the solver it is built from.
 
     .venv/bin/python effects/particle_clouds/bench/table_resolution.py [--g 0.85]
-        [--out effects/particle_clouds/docs/table_resolution.txt]
+        [--parts angles taus build] [--out effects/particle_clouds/docs/table_resolution.txt]
 
 The table (effects/particle_clouds/physics.md section 3) interpolates the reference particle's light
 in four coordinates: the entry point's angle from the sun, the ray's zenith and azimuth there, and
@@ -17,6 +17,9 @@ measured in two parts:
 
 Errors are relative errors of the total radiance (order 1 plus orders 2..18) over the rays above
 1e-3 of the largest: median, 99th percentile and maximum. Build time and size per table.
+
+3. the build: the tables the renderer builds for quality.particle_table "full" and "preview"
+   (every order, eq. 2.11), timed at --g (the presets' particles have g = 0.7).
 """
 
 from __future__ import annotations
@@ -85,44 +88,57 @@ def main() -> None:
     ap.add_argument("--g", type=float, default=0.85)
     ap.add_argument("--rays", type=int, default=400)
     ap.add_argument("--taus", type=float, nargs="+", default=[0.5, 5.0, 30.0])
+    parts = ["angles", "taus", "build"]
+    ap.add_argument("--parts", nargs="+", default=parts, choices=parts)
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     grid = {"orders": 18}
     origins, dirs, normals, suns = random_rays(args.rays, seed=1)
     lines = [f"Particle lighting table against the solver (g = {args.g}, {args.rays} random rays and suns, "
-             "relative error of the total radiance over rays above 1e-3 of the largest)", "",
-             "1. the angles (tables at the tested optical radius: only the angles interpolate)",
-             f"{'tau':>6} {'entry x zenith x azimuth':>25} {'median':>9} {'p99':>9} {'max':>9} "
-             f"{'build s':>8}"]
-    for tau in args.taus:
-        exact = direct(tau, args.g, origins, dirs, suns, grid)
-        for shape in [(16, 8, 16), (32, 16, 32), (48, 24, 48), (64, 32, 64)]:
+             "relative error of the total radiance over rays above 1e-3 of the largest)"]
+    if "angles" in args.parts:
+        lines += ["", "1. the angles (tables at the tested optical radius: only the angles interpolate)",
+                  f"{'tau':>6} {'entry x zenith x azimuth':>25} {'median':>9} {'p99':>9} {'max':>9} "
+                  f"{'build s':>8}"]
+        for tau in args.taus:
+            exact = direct(tau, args.g, origins, dirs, suns, grid)
+            for shape in [(16, 8, 16), (32, 16, 32), (48, 24, 48), (64, 32, 64)]:
+                t0 = time.perf_counter()
+                keys = {"entry": shape[0], "view_zenith": shape[1], "view_azimuth": shape[2], "taus": 2,
+                        "tau_min": tau, "tau_max": tau * 1.5, "grid": grid}
+                table = core.ParticleTable(args.g, keys)
+                build = time.perf_counter() - t0
+                med, p99, mx = stats(lookup(table, tau, normals, dirs, suns), exact)
+                lines.append(f"{tau:6.1f} {'x'.join(map(str, shape)):>25} {med:9.2e} {p99:9.2e} {mx:9.2e} "
+                             f"{build:8.1f}")
+                print(lines[-1], file=sys.stderr)
+    if "taus" in args.parts:
+        lines += ["", "2. the optical radius (tables over [0.1, 50], looked up halfway between nodes, "
+                  "in log)",
+                  f"{'radii':>6} {'median':>9} {'p99':>9} {'max':>9} {'build s':>8} {'MiB':>6}"]
+        for count in [12, 24]:
             t0 = time.perf_counter()
-            keys = {"entry": shape[0], "view_zenith": shape[1], "view_azimuth": shape[2], "taus": 2,
-                    "tau_min": tau, "tau_max": tau * 1.5, "grid": grid}
-            table = core.ParticleTable(args.g, keys)
+            table = core.ParticleTable(args.g, {"taus": count, "grid": grid})
             build = time.perf_counter() - t0
-            med, p99, mx = stats(lookup(table, tau, normals, dirs, suns), exact)
-            lines.append(f"{tau:6.1f} {'x'.join(map(str, shape)):>25} {med:9.2e} {p99:9.2e} {mx:9.2e} "
-                         f"{build:8.1f}")
+            nodes = 0.1 * (50.0 / 0.1) ** (np.arange(count) / (count - 1))
+            mids = np.sqrt(nodes[:-1] * nodes[1:])[:: max(1, (count - 1) // 4)]
+            errs = []
+            for tau in mids:
+                exact = direct(float(tau), args.g, origins, dirs, suns, grid)
+                keep = exact > 1e-3 * exact.max()
+                looked_up = lookup(table, float(tau), normals, dirs, suns)
+                errs.append(np.abs(looked_up - exact)[keep] / exact[keep])
+            rel = np.concatenate(errs)
+            lines.append(f"{count:6d} {np.median(rel):9.2e} {np.percentile(rel, 99):9.2e} {rel.max():9.2e} "
+                         f"{build:8.1f} {table.bytes / 2**20:6.2f}")
             print(lines[-1], file=sys.stderr)
-    lines += ["", "2. the optical radius (tables over [0.1, 50], looked up halfway between nodes, in log)",
-              f"{'radii':>6} {'median':>9} {'p99':>9} {'max':>9} {'build s':>8} {'MiB':>6}"]
-    for count in [12, 24]:
-        t0 = time.perf_counter()
-        table = core.ParticleTable(args.g, {"taus": count, "grid": grid})
-        build = time.perf_counter() - t0
-        nodes = 0.1 * (50.0 / 0.1) ** (np.arange(count) / (count - 1))
-        mids = np.sqrt(nodes[:-1] * nodes[1:])[:: max(1, (count - 1) // 4)]
-        errs = []
-        for tau in mids:
-            exact = direct(float(tau), args.g, origins, dirs, suns, grid)
-            keep = exact > 1e-3 * exact.max()
-            errs.append(np.abs(lookup(table, float(tau), normals, dirs, suns) - exact)[keep] / exact[keep])
-        rel = np.concatenate(errs)
-        lines.append(f"{count:6d} {np.median(rel):9.2e} {np.percentile(rel, 99):9.2e} {rel.max():9.2e} "
-                     f"{build:8.1f} {table.bytes / 2**20:6.2f}")
-        print(lines[-1], file=sys.stderr)
+    if "build" in args.parts:
+        lines += ["", f"3. the renderer's tables at g = {args.g} (every order)",
+                  f"{'quality':>8} {'build s':>8} {'MiB':>6}"]
+        for quality in ["full", "preview"]:
+            table = core.ParticleTable.for_quality(args.g, quality)
+            lines.append(f"{quality:>8} {table.build_seconds:8.1f} {table.bytes / 2**20:6.2f}")
+            print(lines[-1], file=sys.stderr)
     text = "\n".join(lines)
     print(text)
     if args.out:
