@@ -155,24 +155,18 @@ struct SphereScattering::Impl {
         std::array<double, 4> w{0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2), 0.5 * (-3 * f3 + 4 * f2 + f),
                                 0.5 * (f3 - f2)};
         std::array<int, 4> at{node - 1, node, node + 1, node + 2};
-        if (at[0] < 0) {
+        // A missing end node: the mirror node, or the line through the two nearest (a = 2 b - c).
+        auto stand_in = [&](int end, int near, int far, int mirror_node) {
             if (mirror) {
-                at[0] = std::min(1, n - 1);
-            } else {  // a = 2 b - c
-                w[1] += 2.0 * w[0];
-                w[2] -= w[0];
-                w[0] = 0.0;
+                at[end] = mirror_node;
+                return;
             }
-        }
-        if (at[3] > n - 1) {
-            if (mirror) {
-                at[3] = std::max(0, n - 2);
-            } else {  // d = 2 c - b
-                w[2] += 2.0 * w[3];
-                w[1] -= w[3];
-                w[3] = 0.0;
-            }
-        }
+            w[near] += 2.0 * w[end];
+            w[far] -= w[end];
+            w[end] = 0.0;
+        };
+        if (at[0] < 0) stand_in(0, 1, 2, std::min(1, n - 1));
+        if (at[3] > n - 1) stand_in(3, 2, 1, std::max(0, n - 2));
         int count = 0;
         for (int i = 0; i < 4; ++i)
             if (w[i] != 0.0) {
@@ -196,6 +190,9 @@ struct SphereScattering::Impl {
             }
         return taps;
     }
+    PositionTaps position_taps(const GridPoint& p) const {
+        return position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
+    }
     // A field on the grid ([position][direction]) at the taps, bilinear in the direction (zenith, azimuth
     // nodes and fractions).
     double interpolate(const std::vector<float>& field, const PositionTaps& taps, int zenith_node, double zenith_frac,
@@ -211,8 +208,7 @@ struct SphereScattering::Impl {
         return sum;
     }
     double interpolate(const std::vector<float>& field, const GridPoint& p) const {
-        return interpolate(field, position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]), p.node[2], p.frac[2],
-                           p.node[3], p.frac[3]);
+        return interpolate(field, position_taps(p), p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
     // A field by position only (a peak coefficient) at the taps.
     static double interpolate(const float* by_position, const PositionTaps& taps) {
@@ -222,7 +218,7 @@ struct SphereScattering::Impl {
     }
     // J_k at grid point p toward an observer looking along w, from its grid (eq. 2.8).
     double order_source(const OrderSource& o, const GridPoint& p, const Vec& w) const {
-        const PositionTaps taps = position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
+        const PositionTaps taps = position_taps(p);
         return interpolate(o.peak.data(), taps) * hg_of(o.peak_g, w.z) +
                interpolate(o.rest, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
@@ -649,8 +645,7 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     auto peak_integral = [&](size_t k) {
         return impl_->march(entry, v, steps, [&](const Vec& x) {
             const GridPoint p = impl_->locate(x, v);
-            return Impl::interpolate(impl_->source[k].peak.data(),
-                                     impl_->position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]));
+            return Impl::interpolate(impl_->source[k].peak.data(), impl_->position_taps(p));
         });
     };
     if (orders >= 1) out[1] = peak_integral(0);
@@ -661,7 +656,7 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     for (size_t k = 2; k < orders; ++k) peak_phase[k] = Impl::hg_of(impl_->source[k].peak_g, v.z);
     out[3] = impl_->march(entry, v, steps, [&](const Vec& x) {
         const GridPoint p = impl_->locate(x, v);
-        const Impl::PositionTaps taps = impl_->position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
+        const Impl::PositionTaps taps = impl_->position_taps(p);
         double peak = 0.0;
         for (int i = 0; i < taps.count; ++i) {
             const float* e = impl_->peaks.data() + size_t(taps.position[i]) * orders;
