@@ -311,11 +311,12 @@ def mitsuba_scene(grid: Grid, g: float, sun: np.ndarray) -> tuple[Any, Any]:
 
 
 def render(scene: Any, medium: Any, origin: np.ndarray, dirs: np.ndarray, spp: int, max_depth: int,
-           seed: int) -> Render:
+           seed: int, rr_depth: int = RR_DEPTH) -> Render:
     """Mean and standard error of volpath's radiance along each direction from ``origin``:
-    ``spp`` samples each, in batches of at most BATCH lanes, batch b seeded (seed, b)."""
+    ``spp`` samples each, in batches of at most BATCH lanes, batch b seeded (seed, b); Russian
+    roulette after ``rr_depth`` real scatterings."""
     mi = _mi
-    integrator = mi.load_dict({"type": "volpath", "max_depth": int(max_depth), "rr_depth": RR_DEPTH})
+    integrator = mi.load_dict({"type": "volpath", "max_depth": int(max_depth), "rr_depth": int(rr_depth)})
     sampler = mi.load_dict({"type": "independent"})
     n = len(dirs)
     per_batch = max(1, BATCH // n)

@@ -9,8 +9,13 @@ transmitted unscattered never counted).
 
 Mitsuba. ``volpath`` in ``llvm_ad_mono`` as in effects/noise_clouds/bench/fit_octaves.py, whose
 ``configure_llvm`` (Dr.Jit needs a libLLVM >= 16), ``load_mitsuba`` and ``render`` (rays from one
-origin go to ``volpath.sample`` directly, batch b seeded (seed, b), Russian roulette only after
-fit_octaves.RR_DEPTH = 2000 vertices, i.e. never here) are imported, not copied. Scene: a
+origin go to ``volpath.sample`` directly, batch b seeded (seed, b)) are imported, not copied.
+Russian roulette never (RR_DEPTH below): with albedo 1 a path's throughput stays 1, so volpath's
+roulette would keep a path with probability 0.95 per vertex and weight the survivors by 0.95^-n.
+That is unbiased on paper and biased in any real run: the light of a thick isotropic sphere's
+shadowed side takes thousands of scatterings to get there (the numpy tracer's camera paths at
+tau = 50, g = 0 run to 9000 orders), and with fit_octaves' RR_DEPTH = 2000 Mitsuba came out 30-50 %
+dark on those rays against sphere_paths. Scene: a
 ``sphere`` (radius 1, centre 0; --radius scales the world) with a ``null`` BSDF and an interior
 ``homogeneous`` medium (sigma_t = tau, albedo 1, ``hg`` phase of g; ``isotropic`` for g = 0, as
 fit_octaves does), a ``directional`` emitter of direction -sun and irradiance 1, nothing else.
@@ -81,6 +86,7 @@ import fit_octaves as fo  # noqa: E402
 import sphere_paths as sp  # noqa: E402
 
 CHUNKS = 16  # copies of each ray: the batch means of the per-order differences
+RR_DEPTH = 1 << 30  # volpath's rr_depth: never (module docstring); every path leaves the sphere anyway
 
 
 def load(threads: int | None = None, libllvm: str | None = None) -> Any:
@@ -131,7 +137,7 @@ def _chunk_means(tau: float, g: float, sun: np.ndarray, origins: np.ndarray, dir
     for origin, idx in groups.items():
         rays = np.repeat(dirs[idx], chunks, axis=0)
         for depth in max_depths:
-            r = fo.render(scene, None, radius * np.array(origin), rays, per, depth, seed)
+            r = fo.render(scene, None, radius * np.array(origin), rays, per, depth, seed, RR_DEPTH)
             out[depth][idx] = r.mean.reshape(len(idx), chunks)
             seconds[depth] += r.seconds
         samples += per * len(rays)
