@@ -58,43 +58,6 @@ struct RadialMap {
     }
 };
 
-// Polar nodes graded toward the terminator (eq. 2.14). The sun grazes the surface there, and a thick
-// particle's light changes from lit to shadowed within a few mean free paths along it: a uniform step
-// of pi / 31 is 5 of them at tau = 50, and order 2 came out twice too bright on rays entering there.
-// The node index is s(theta) = G(phi) / G(pi / 2), phi = theta - pi / 2, scaled from [-1, 1] to
-// [0, n - 1], with G(phi) = phi + k w tanh(phi / w): nodes 1 + k times denser within about w of the
-// terminator, where the step is the smaller of kStep / tau and the uniform step, and nearly uniform
-// toward the poles (the mirror node past a pole stays consistent).
-struct PolarMap {
-    static constexpr double kStep = 0.5;   // the step at the terminator, in mean free paths
-    static constexpr double kWidth = 8.0;  // w in steps at the terminator (at most a quarter of the nodes)
-    int n = 2;
-    double k = 0.0, w = 1.0;  // k = 0: uniform
-    std::vector<double> angles;
-
-    PolarMap(int nodes, double tau) : n(nodes), angles(size_t(nodes)) {
-        const double uniform = kPi / (n - 1);
-        const double step = std::min(uniform, kStep / tau);
-        w = std::min(kWidth, 0.25 * (n - 1)) * step;
-        // the step at phi = 0 is (2 / (n - 1)) G(pi / 2) / (1 + k); G(pi / 2) ~ pi / 2 + k w tanh(pi / 2w)
-        const double span = w * std::tanh(0.5 * kPi / w);
-        k = std::max(0.0, (uniform - step) / (step - 2.0 * span / (n - 1)));
-        for (int j = 0; j < n; ++j) {
-            double lo = 0.0, hi = kPi;
-            for (int it = 0; it < 100; ++it) {
-                const double mid = 0.5 * (lo + hi);
-                (index(mid) < j ? lo : hi) = mid;
-            }
-            angles[size_t(j)] = j == 0 ? 0.0 : j == n - 1 ? kPi : 0.5 * (lo + hi);
-        }
-    }
-    double g(double phi) const { return phi + k * w * std::tanh(phi / w); }
-    double angle(int j) const { return angles[size_t(j)]; }
-    double index(double theta) const {  // fractional node index of the polar angle theta
-        return 0.5 * (g(theta - 0.5 * kPi) / g(0.5 * kPi) + 1.0) * (n - 1);
-    }
-};
-
 // A point of the 4-D grid: the lower node and the fraction toward the next, per axis (r, polar, zenith, azimuth).
 struct GridPoint {
     std::array<int, 4> node;
@@ -104,6 +67,31 @@ struct GridPoint {
 using numerics::node_and_fraction;
 
 }  // namespace
+
+TerminatorNodes::TerminatorNodes(int nodes, double tau) : n_(nodes) {
+    if (nodes < 2) throw std::invalid_argument("TerminatorNodes: nodes must be at least 2");
+    const double uniform = kPi / (n_ - 1), step = std::min(uniform, kStep / tau);
+    w_ = std::min(kWidth, 0.25 * (n_ - 1)) * step;
+    // The step at phi = 0 is (2 / (n - 1)) G(pi / 2) / (1 + k), G(pi / 2) = pi / 2 + k w tanh(pi / 2w).
+    const double span = w_ * std::tanh(0.5 * kPi / w_);
+    k_ = std::max(0.0, (uniform - step) / (step - 2.0 * span / (n_ - 1)));
+}
+
+double TerminatorNodes::angle(int j) const {
+    if (j <= 0) return 0.0;
+    if (j >= n_ - 1) return kPi;
+    double lo = 0.0, hi = kPi;  // index() rises with the angle
+    for (int it = 0; it < 60; ++it) {
+        const double mid = 0.5 * (lo + hi);
+        (index(mid) < j ? lo : hi) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
+double TerminatorNodes::index(double theta) const {
+    auto g = [&](double phi) { return phi + k_ * w_ * std::tanh(phi / w_); };
+    return 0.5 * (g(theta - 0.5 * kPi) / g(0.5 * kPi) + 1.0) * (n_ - 1);
+}
 
 void validate_sphere_grid(const SphereGrid& grid) {
     auto check = [](const char* name, int value, int lo, int hi) {
@@ -123,7 +111,8 @@ struct SphereScattering::Impl {
     double tau, g;
     SphereGrid grid;
     RadialMap radial;
-    PolarMap polar_map;
+    TerminatorNodes polar_nodes;
+    std::vector<double> polar_angles;  // polar_nodes.angle(j), once
     int dirs, positions;
     // J_k for k >= 2 (eq. 2.8): peak[p] p_{g^k}(sun . v) + rest[p][direction] at the nodes.
     struct OrderSource {
@@ -142,7 +131,9 @@ struct SphereScattering::Impl {
     static constexpr double kBeyondTolerance = 1e-4;
     static constexpr int kBeyondIterations = 200;  // tau = 50 takes 32-48
 
-    Impl(double tau_, double g_, const SphereGrid& grid_) : tau(tau_), g(g_), grid(grid_), radial(grid_.radii, tau_), polar_map(grid_.polar, tau_) {
+    Impl(double tau_, double g_, const SphereGrid& grid_)
+        : tau(tau_), g(g_), grid(grid_), radial(grid_.radii, tau_), polar_nodes(grid_.polar, tau_) {
+        for (int j = 0; j < grid.polar; ++j) polar_angles.push_back(polar_nodes.angle(j));
         dirs = grid.zenith * grid.azimuth;
         positions = grid.radii * grid.polar;
     }
@@ -153,7 +144,7 @@ struct SphereScattering::Impl {
     double single_source(const Vec& y, const Vec& w) const {
         return tau * hg(w.z) * std::exp(-tau * exit_distance(y, Vec{0.0, 0.0, 1.0}));
     }
-    double polar_angle(int j) const { return polar_map.angle(j); }
+    double polar_angle(int j) const { return polar_angles[size_t(j)]; }
     double zenith_angle(int k) const { return kPi * k / (grid.zenith - 1); }
     double azimuth_angle(int l) const { return kPi * l / (grid.azimuth - 1); }
 
@@ -170,8 +161,7 @@ struct SphereScattering::Impl {
         frame(y, n, t, b);
         GridPoint p;
         node_and_fraction(radial.index(std::sqrt(dot(y, y))), grid.radii, p.node[0], p.frac[0]);
-        node_and_fraction(polar_map.index(std::atan2(std::hypot(n.x, n.y), n.z)), grid.polar, p.node[1],
-                          p.frac[1]);
+        node_and_fraction(polar_nodes.index(std::atan2(std::hypot(n.x, n.y), n.z)), grid.polar, p.node[1], p.frac[1]);
         node_and_fraction(std::acos(std::clamp(dot(w, n), -1.0, 1.0)) / kPi * (grid.zenith - 1), grid.zenith, p.node[2],
                           p.frac[2]);
         node_and_fraction(std::atan2(std::fabs(dot(w, b)), dot(w, t)) / kPi * (grid.azimuth - 1), grid.azimuth,

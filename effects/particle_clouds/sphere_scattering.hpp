@@ -11,6 +11,28 @@
 
 namespace airlight {
 
+// Angles from the sun's axis, [0, pi], on `nodes` nodes graded toward the terminator (physics.md
+// eq. 2.14): a thick particle's light turns from lit to shadowed within a few mean free paths of it.
+// The node index is s(theta) = (G(phi) / G(pi / 2) + 1) (nodes - 1) / 2, phi = theta - pi / 2,
+// G(phi) = phi + k w tanh(phi / w): the step at the terminator is the smaller of kStep / tau and the
+// uniform step (k = 0 then), w is kWidth of those steps (at most a quarter of the nodes), and the
+// nodes are nearly uniform toward the poles. The solver's polar nodes and the particle table's
+// entry angles (particle_clouds.glsl computes the same k and w) use it.
+class TerminatorNodes {
+public:
+    static constexpr double kStep = 0.5;   // the step at the terminator, in mean free paths
+    static constexpr double kWidth = 8.0;  // w in steps at the terminator
+    TerminatorNodes(int nodes, double tau);
+    double angle(int j) const;         // node j's angle (by bisection: keep it where it is used often)
+    double index(double theta) const;  // the fractional node index of the angle theta
+    double k() const { return k_; }
+    double w() const { return w_; }
+
+private:
+    int n_;
+    double k_ = 0.0, w_ = 1.0;  // k = 0: uniform
+};
+
 // How finely the light field inside the sphere is resolved (physics.md
 // section 2.3; the defaults are chosen in effects/particle_clouds/docs/).
 struct SphereGrid {
