@@ -290,9 +290,10 @@ airlight::SphereGrid parse_sphere_grid(const py::dict& keys) {
     airlight::SphereGrid grid;
     for (auto item : keys) {
         const std::string key = py::str(item.first);
-        if (key == "beyond") {
-            if (!py::isinstance<py::bool_>(item.second)) throw py::type_error("grid.beyond: must be true or false");
-            grid.beyond = item.second.cast<bool>();
+        if (key == "beyond" || key == "graded_polar") {
+            if (!py::isinstance<py::bool_>(item.second))
+                throw py::type_error("grid." + key + ": must be true or false");
+            (key == "beyond" ? grid.beyond : grid.graded_polar) = item.second.cast<bool>();
             continue;
         }
         int* field = key == "radii"         ? &grid.radii

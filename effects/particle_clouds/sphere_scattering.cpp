@@ -70,7 +70,7 @@ using numerics::node_and_fraction;
 
 TerminatorNodes::TerminatorNodes(int nodes, double tau) : n_(nodes) {
     if (nodes < 2) throw std::invalid_argument("TerminatorNodes: nodes must be at least 2");
-    const double uniform = kPi / (n_ - 1), step = std::min(uniform, kStep / tau);
+    const double uniform = kPi / (n_ - 1), step = tau > 0.0 ? std::min(uniform, kStep / tau) : uniform;
     w_ = std::min(kWidth, 0.25 * (n_ - 1)) * step;
     // The step at phi = 0 is (2 / (n - 1)) G(pi / 2) / (1 + k), G(pi / 2) = pi / 2 + k w tanh(pi / 2w).
     const double span = w_ * std::tanh(0.5 * kPi / w_);
@@ -132,7 +132,11 @@ struct SphereScattering::Impl {
     static constexpr int kBeyondIterations = 200;  // tau = 50 takes 32-48
 
     Impl(double tau_, double g_, const SphereGrid& grid_)
-        : tau(tau_), g(g_), grid(grid_), radial(grid_.radii, tau_), polar_nodes(grid_.polar, tau_) {
+        : tau(tau_),
+          g(g_),
+          grid(grid_),
+          radial(grid_.radii, tau_),
+          polar_nodes(grid_.polar, grid_.graded_polar ? tau_ : 0.0) {
         for (int j = 0; j < grid.polar; ++j) polar_angles.push_back(polar_nodes.angle(j));
         dirs = grid.zenith * grid.azimuth;
         positions = grid.radii * grid.polar;

@@ -20,11 +20,11 @@ namespace airlight {
 // entry angles (particle_clouds.glsl computes the same k and w) use it.
 class TerminatorNodes {
 public:
-    static constexpr double kStep = 0.5;   // the step at the terminator, in mean free paths
-    static constexpr double kWidth = 8.0;  // w in steps at the terminator
-    TerminatorNodes(int nodes, double tau);
-    double angle(int j) const;         // node j's angle (by bisection: keep it where it is used often)
-    double index(double theta) const;  // the fractional node index of the angle theta
+    static constexpr double kStep = 0.5;     // the step at the terminator, in mean free paths
+    static constexpr double kWidth = 8.0;    // w in steps at the terminator
+    TerminatorNodes(int nodes, double tau);  // tau = 0: uniform nodes
+    double angle(int j) const;               // node j's angle (by bisection: keep it where it is used often)
+    double index(double theta) const;        // the fractional node index of the angle theta
     double k() const { return k_; }
     double w() const { return w_; }
 
@@ -37,7 +37,7 @@ private:
 // section 2.3; the defaults are chosen in effects/particle_clouds/docs/).
 struct SphereGrid {
     int radii = 16;        // radial nodes, graded toward the surface in optical depth (eq. 2.7)
-    int polar = 32;        // the position's angle from the sun's axis, [0, pi]
+    int polar = 32;        // the position's angle from the sun's axis, [0, pi], graded toward the terminator
     int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
     int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
     int march_steps = 16;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
@@ -46,6 +46,8 @@ struct SphereGrid {
     // still inside after 18 orders is 19-60 % of what it scatters (effects/particle_clouds/physics.md
     // section 2.7). Off, the orders stop at `orders`, as in the source.
     bool beyond = false;
+    // The polar nodes graded toward the terminator (eq. 2.14); off, uniform (for comparison only).
+    bool graded_polar = true;
 };
 
 // Throws std::invalid_argument naming the field when a resolution is out of range.

@@ -22,7 +22,8 @@ Conventions
 
 Estimators
 ----------
-``radiance_by_order``: backward paths from the camera. The first collision is forced inside the
+``radiance_by_order``: backward paths from the camera (``radiance_all_orders``: the same paths
+followed to the end, every order summed). The first collision is forced inside the
 chord (distance from the truncated exponential, weight 1 - exp(-tau chord)); at every vertex x with
 path direction d (the reverse of the light's propagation) next-event estimation toward the sun
 adds weight * p(sun . d) * exp(-tau D(x)) to the order of that vertex; the next path direction d'
@@ -171,6 +172,48 @@ def radiance_by_order(tau: float, g: float, sun: np.ndarray, origins: np.ndarray
         return mean, np.full_like(mean, np.nan)
     var = np.maximum(s2 / paths - mean * mean, 0.0) * paths / (paths - 1)
     return mean, np.sqrt(var / paths)
+
+
+def radiance_all_orders(tau: float, g: float, sun: np.ndarray, origins: np.ndarray, dirs: np.ndarray,
+                        paths: int = 4096, seed: int = 0) -> tuple[np.ndarray, np.ndarray, int]:
+    """Mean and standard error of the radiance of every order summed along each ray (n_rays,), and the
+    most orders any path took: the camera paths of ``radiance_by_order`` followed until every one has
+    left the sphere (no cut, no roulette; with albedo 1 the weight never changes). A thick isotropic
+    sphere's shadowed side is lit by paths of thousands of scatterings (tau = 50, g = 0: up to about
+    9000); about 90 s per 1.6 million paths there on one core."""
+    sun = _unit(sun).reshape(3)
+    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    dirs = _unit(np.asarray(dirs, dtype=np.float64).reshape(-1, 3))
+    n = len(dirs)
+    t0, t1 = chords(origins, dirs)
+    chord = np.maximum(t1 - t0, 0.0)
+    hit = np.nonzero(chord > 0.0)[0]
+    s1, s2 = np.zeros(n), np.zeros(n)
+    rng = np.random.default_rng(seed)
+    ray_of_path = np.repeat(hit, paths)
+    most = 0
+    for start in range(0, len(ray_of_path), CHUNK):
+        r = ray_of_path[start:start + CHUNK]
+        alive = np.arange(len(r))  # the paths still inside, by index into r
+        total = np.zeros(len(r))  # each path's summed next-event estimates
+        w = -np.expm1(-tau * chord[r])  # the forced first collision's weight
+        s = -np.log1p(-rng.random(len(r)) * w) / tau
+        x = origins[r] + (t0[r] + s)[:, None] * dirs[r]
+        d = dirs[r]
+        order = 0
+        while len(alive):
+            total[alive] += w[alive] * hg_phase(d @ sun, g) * np.exp(-tau * exit_distance(x, sun))
+            order += 1
+            d = _scatter(d, g, rng)
+            s = -np.log1p(-rng.random(len(alive))) / tau
+            inside = s < exit_distance(x, d)
+            alive, x, d = alive[inside], x[inside] + s[inside, None] * d[inside], d[inside]
+        most = max(most, order)
+        s1 += np.bincount(r, weights=total, minlength=n)
+        s2 += np.bincount(r, weights=total * total, minlength=n)
+    mean = s1 / paths
+    var = np.maximum(s2 / paths - mean * mean, 0.0) * paths / max(paths - 1, 1)
+    return mean, np.sqrt(var / paths), most
 
 
 def single_scattering(tau: float, g: float, sun: np.ndarray, origins: np.ndarray,

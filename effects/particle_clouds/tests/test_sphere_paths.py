@@ -115,6 +115,17 @@ def test_deterministic_for_a_seed() -> None:
     assert np.array_equal(f[0], sp.escaping_flux_by_order(2.0, 0.6, orders=4, paths=5000, seed=9)[0])
 
 
+def test_every_order_summed_is_the_orders_followed_to_the_end() -> None:
+    # The same camera paths (same seed, same draws) followed until all have left: their sum over every
+    # order equals the per-order tallies taken to the most orders any path took; misses are 0.
+    origins, dirs = camera_rays()
+    total, se, most = sp.radiance_all_orders(3.0, 0.3, SUNS["side"], origins, dirs, paths=400, seed=4)
+    by_order, _ = sp.radiance_by_order(3.0, 0.3, SUNS["side"], origins, dirs, orders=most, paths=400, seed=4)
+    assert most > 20 and total[-1] == 0.0 and se[-1] == 0.0
+    np.testing.assert_allclose(total, by_order.sum(axis=1), rtol=1e-12)
+    assert np.all(se[:-1] > 0.0)
+
+
 # ------------------------------------------------------------------------------------------------
 # Sun paths
 

@@ -158,6 +158,8 @@ def test_light_entering_where_the_sun_grazes_matches_the_path_tracer(tau: float,
     traced, stderr = sphere_paths.radiance_by_order(tau, g, SUN, origins, dirs, orders=orders, paths=1 << 17,
                                                     seed=7)
     np.testing.assert_array_less(np.abs(mine - traced), 0.03 * traced + 4.0 * stderr)
+    uniform = solve(tau, g, SUN, origins, dirs, {"orders": orders, "graded_polar": False}, 1024)
+    assert (np.abs(uniform - traced) > 0.03 * traced + 4.0 * stderr).any()  # what the grading fixes
 
 
 @pytest.mark.slow
@@ -187,10 +189,11 @@ def test_a_bad_grid_is_a_clear_error(grid: dict, field: str) -> None:
         solve(1.0, 0.5, SUN, origins, dirs, grid, 16)
 
 
-def test_a_beyond_that_is_not_a_bool_is_a_clear_error() -> None:
+@pytest.mark.parametrize("key", ["beyond", "graded_polar"])
+def test_a_switch_that_is_not_a_bool_is_a_clear_error(key: str) -> None:
     origins, dirs = orthographic_rays([1.0, 0.0, 0.0], [(0.0, 0.0)])
-    with pytest.raises(TypeError, match="grid.beyond"):
-        solve(1.0, 0.5, SUN, origins, dirs, {"beyond": "yes"}, 16)
+    with pytest.raises(TypeError, match=f"grid.{key}"):
+        solve(1.0, 0.5, SUN, origins, dirs, {key: "yes"}, 16)
 
 
 @pytest.mark.parametrize(("tau", "g", "field"), [(0.0, 0.5, "tau"), (1e4, 0.5, "tau"), (1.0, 1.0, "g"),
