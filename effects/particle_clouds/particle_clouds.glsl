@@ -9,37 +9,11 @@ int particle_index_at(int k) {
     return int(table_texel(TABLE_PARTICLE_TILES, k % PARTICLE_ROW_TEXELS, k / PARTICLE_ROW_TEXELS));
 }
 
-// The lower node of a fractional index on n nodes (clamped to [0, n - 2]) and the fraction past it.
-int particle_node(float x, int n, OUT(float) f) {
-    float c = clamp(x, 0.0f, float(n - 1));
-    int i = min(int(c), n - 2);
-    f = c - float(i);
-    return i;
-}
-
-// The fractional node of the entry angle theta (from the sun) on n nodes
-// graded toward the terminator for optical radius tau (eq. 2.14; the same
-// as TerminatorNodes::index): G(phi) = phi + k w tanh(phi / w).
-float particle_entry_index(float theta, int n, float tau) {
-    float uniform_step = PI / float(n - 1);
-    float step = min(uniform_step, PARTICLE_TERMINATOR_STEP / tau);
-    float w = min(PARTICLE_TERMINATOR_WIDTH, 0.25f * float(n - 1)) * step;
-    float span = w * tanh(min(0.5f * PI / w, 20.0f));
-    float k = max(0.0f, (uniform_step - step) / (step - 2.0f * span / float(n - 1)));
-    float phi = theta - 0.5f * PI;
-    float g = phi + k * w * tanh(clamp(phi / w, -20.0f, 20.0f));
-    return 0.5f * (g / (0.5f * PI + k * span) + 1.0f) * float(n - 1);
-}
-
 // One optical-radius slice m of the lighting table (eq. 3.1): its four
-// channels trilinear in the entry angle (the slice's own nodes, eq. 2.14),
-// view zenith and view azimuth (nodes z, a and the fractions toward the
-// next in f.yz).
-vec4 particle_slice(int m, float entry_angle, ivec3 node, vec3 f) {
+// channels trilinear in the entry angle, view zenith and view azimuth
+// (nodes e, z, a and the fractions toward the next in f).
+vec4 particle_slice(int m, ivec3 node, vec3 f) {
     ivec4 n = frame.particle_clouds.table_shape;
-    vec4 taus = frame.particle_clouds.table_taus;
-    float slice_tau = taus.x * exp(taus.y * float(m) / float(n.w - 1));
-    node.x = particle_node(particle_entry_index(entry_angle, n.x, slice_tau), n.x, f.x);
     vec4 sum = vec4(0.0f);
     for (int corner = 0; corner < 8; ++corner) {
         int de = corner & 1;
@@ -51,6 +25,14 @@ vec4 particle_slice(int m, float entry_angle, ivec3 node, vec3 f) {
         sum += w * table_texel4(TABLE_PARTICLE_LIGHT, x, y);
     }
     return sum;
+}
+
+// The lower node of a fractional index on n nodes (clamped to [0, n - 2]) and the fraction past it.
+int particle_node(float x, int n, OUT(float) f) {
+    float c = clamp(x, 0.0f, float(n - 1));
+    int i = min(int(c), n - 2);
+    f = c - float(i);
+    return i;
 }
 
 // A Catmull-Rom cubic through b, c at f in [0, 1], a missing end (has_a,
@@ -89,9 +71,7 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
     }
     vec3 f;
     ivec3 node;
-    float entry_angle = precise_acos(cos_entry);
-    node.x = 0;
-    f.x = 0.0f;
+    node.x = particle_node(precise_acos(cos_entry) / PI * float(shape.x - 1), shape.x, f.x);
     float zenith = precise_acos(cos_view) / (0.5f * PI);
     node.y = particle_node((1.0f - pow(max(1.0f - zenith, 0.0f), 1.0f / 1.5f)) * float(shape.y - 1), shape.y, f.y);
     node.z = particle_node(psi / PI * float(shape.z - 1), shape.z, f.z);
@@ -104,7 +84,7 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
     vec4 slices[4];
     slices[0] = vec4(0.0f);
     slices[3] = vec4(0.0f);
-    for (int j = below ? 0 : 1; j < (above ? 4 : 3); ++j) slices[j] = particle_slice(m - 1 + j, entry_angle, node, f);
+    for (int j = below ? 0 : 1; j < (above ? 4 : 3); ++j) slices[j] = particle_slice(m - 1 + j, node, f);
     vec4 vm = slices[0];
     vec4 v0 = slices[1];
     vec4 v1 = slices[2];

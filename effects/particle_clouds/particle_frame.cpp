@@ -18,14 +18,9 @@ namespace airlight {
 
 namespace {
 
-// The shaders' entry-angle nodes (particle_clouds.glsl) are the table's (eq. 2.14).
-static_assert(shader::PARTICLE_TERMINATOR_STEP == float(TerminatorNodes::kStep) &&
-                  shader::PARTICLE_TERMINATOR_WIDTH == float(TerminatorNodes::kWidth),
-              "particle_layout.glsl's terminator grading differs from TerminatorNodes'");
-
 // Bumped whenever the solver or the table's layout changes: older files on disk are ignored.
-constexpr int TABLE_FILE_VERSION = 4;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
-                                       // 4: polar nodes graded toward the terminator (2.14)
+constexpr int TABLE_FILE_VERSION = 5;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
+                                        // 4, 5: polar nodes graded toward the terminator (2.14)
 
 // Where built tables are kept: $AIRLIGHT_CACHE_DIR, else $XDG_CACHE_HOME/airlight, else
 // ~/.cache/airlight; empty (no disk cache) when none can be named.

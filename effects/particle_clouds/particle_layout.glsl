@@ -9,11 +9,6 @@ CONST int PARTICLE_TILE_SIZE = 16;
 // A pixel's compositing stops once the particles in front pass less than
 // this fraction of the light behind them (section 6).
 CONST float PARTICLE_OPAQUE = 1.0e-4f;
-// The lighting table's entry angles are graded toward the terminator (eq. 2.14): the step there in
-// mean free paths of the slice's optical radius, and the width w in those steps
-// (TerminatorNodes::kStep and kWidth, checked equal in particle_frame.cpp).
-CONST float PARTICLE_TERMINATOR_STEP = 0.5f;
-CONST float PARTICLE_TERMINATOR_WIDTH = 8.0f;
 
 struct ParticleCloudsGpu {
     ivec4 table_shape;  // the lighting table's nodes: x entry angles, y view zeniths, z view azimuths, w optical radii

@@ -43,18 +43,15 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
     const int E = shape.entry, Z = shape.view_zenith, A = shape.view_azimuth;
     const size_t slice = size_t(E) * Z * A * 4;
     nodes_.assign(slice * shape.taus, 0.0f);
-    // Each slice's entry angles are graded toward the terminator by its optical radius (eq. 2.14).
-    for (int m = 0; m < shape.taus; ++m) entry_nodes_.emplace_back(E, slice_tau(m));
     for (int m = 0; m < shape.taus; ++m) {
         const double tau = slice_tau(m);
         const SphereScattering sphere(tau, g, shape.grid);
-        const TerminatorNodes& entry = entry_nodes_[size_t(m)];
         numerics::parallel_for(E * Z, [&](int ez) {
             // Eq. 3.1: the node's ray in the solver's frame (sun on +z), entering at P = n.
             // The view's zenith at node s in [0, 1] is (pi / 2) (1 - (1 - s)^1.5) (eq. 3.2): dense near
             // grazing, where the chord 2 cos(zenith) and the light along it change fastest.
             const double s = double(ez % Z) / (Z - 1);
-            const double th = entry.angle(ez / Z), ze = 0.5 * kPi * (1.0 - std::pow(1.0 - s, 1.5));
+            const double th = kPi * (ez / Z) / (E - 1), ze = 0.5 * kPi * (1.0 - std::pow(1.0 - s, 1.5));
             const double n[3] = {std::sin(th), 0.0, std::cos(th)}, t[3] = {-std::cos(th), 0.0, std::sin(th)};
             for (int a = 0; a < A; ++a) {
                 const double ps = kPi * a / (A - 1);
@@ -112,6 +109,7 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
     const int E = shape_.entry, Z = shape_.view_zenith, A = shape_.view_azimuth;
     int node[4];
     double frac[4];
+    node_and_fraction(std::acos(cos_entry) / kPi * (E - 1), E, node[0], frac[0]);
     node_and_fraction((1.0 - std::pow(1.0 - std::acos(cos_view) / (0.5 * kPi), 1.0 / 1.5)) * (Z - 1), Z, node[1],
                       frac[1]);
     node_and_fraction(psi / kPi * (A - 1), A, node[2], frac[2]);
@@ -125,10 +123,7 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
     // and of orders 2 and 3's peaks exact for the ray.
     const double mu = sun[0] * view[0] + sun[1] * view[1] + sun[2] * view[2];
     const double p1 = hg(g_, mu), p2 = hg(g_ * g_, mu), p3 = hg(g_ * g_ * g_, mu);
-    const double entry_angle = std::acos(cos_entry);
     auto slice_light = [&](int m) {
-        // The entry angle's nodes are graded toward the terminator by the slice's optical radius (eq. 2.14).
-        node_and_fraction(entry_nodes_[size_t(m)].index(entry_angle), E, node[0], frac[0]);
         double v[4] = {0.0, 0.0, 0.0, 0.0};
         const size_t slice = size_t(m) * E * Z * A * 4;
         for (int corner = 0; corner < 8; ++corner) {

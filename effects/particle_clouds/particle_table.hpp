@@ -13,8 +13,7 @@
 
 namespace airlight {
 
-// The table's nodes (the entry angle graded toward the terminator per optical radius, eq. 2.14; the
-// view's angles as eq. 3.2; log-uniform in the optical radius).
+// The table's nodes (uniform in each angle, log-uniform in the optical radius).
 struct ParticleTableShape {
     int entry = 32;         // the entry point's angle from the sun, [0, pi]
     int view_zenith = 16;   // the ray's angle from the inward normal there, [0, pi / 2]
@@ -54,7 +53,6 @@ private:
     double g_;
     ParticleTableShape shape_;
     std::vector<float> nodes_;
-    std::vector<TerminatorNodes> entry_nodes_;  // per slice: its entry angles' nodes (eq. 2.14)
     double build_seconds_ = 0.0;
 };
 

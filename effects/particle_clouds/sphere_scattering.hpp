@@ -16,8 +16,7 @@ namespace airlight {
 // The node index is s(theta) = (G(phi) / G(pi / 2) + 1) (nodes - 1) / 2, phi = theta - pi / 2,
 // G(phi) = phi + k w tanh(phi / w): the step at the terminator is the smaller of kStep / tau and the
 // uniform step (k = 0 then), w is kWidth of those steps (at most a quarter of the nodes), and the
-// nodes are nearly uniform toward the poles. The solver's polar nodes and the particle table's
-// entry angles (particle_clouds.glsl computes the same k and w) use it.
+// nodes are nearly uniform toward the poles. The solver's polar nodes.
 class TerminatorNodes {
 public:
     static constexpr double kStep = 0.5;     // the step at the terminator, in mean free paths

@@ -36,19 +36,6 @@ def test_the_table_interpolates_the_solver_between_its_angles() -> None:
 
 
 @pytest.mark.slow
-def test_the_table_follows_a_thick_particles_terminator() -> None:
-    # At tau = 20 the light turns from lit to shadowed within a few mean free paths of the terminator:
-    # with uniform entry angles (9 mean free paths apart on 32 nodes) the 99th percentile was 81 % and
-    # the worst ray 98 %; graded toward the terminator (eq. 2.14) 7.7 % and 8.7 %.
-    g, tau = 0.5, 20.0
-    origins, dirs, normals, suns = analysis.random_rays(200, seed=7)
-    exact = analysis.direct(tau, g, origins, dirs, suns, GRID)
-    table = airlight._core.ParticleTable(g, {"taus": 2, "tau_min": tau, "tau_max": 2 * tau, "grid": GRID})
-    med, p99, worst = analysis.stats(lookup_all(table, tau, normals, dirs, suns), exact)
-    assert med < 0.005 and p99 < 0.1 and worst < 0.12, (med, p99, worst)
-
-
-@pytest.mark.slow
 def test_the_table_interpolates_the_solver_between_its_optical_radii() -> None:
     g = 0.5
     origins, dirs, normals, suns = analysis.random_rays(150, seed=8)
