@@ -217,6 +217,26 @@ def plot(path: str, points: list[Point], cases: list[str]) -> None:
     plt.close(fig)
 
 
+def failing_rays(case: str, labels: list[str], st: dict, mine: np.ndarray, ref: np.ndarray, se: np.ndarray,
+                 reference: str) -> list[str]:
+    """One line per failing ray of a case's column (``st`` from ``compare``)."""
+    return [f"{case} {labels[i]:<30} solver {mine[i]:.4e} {reference} {ref[i]:.4e} +- {se[i]:.1e}  "
+            f"rel {st['rel'][i]:+.2%}  z {st['z'][i]:+.1f}" for i in np.nonzero(st["fail"])[0]]
+
+
+def finish(lines: list[str], summary: list[str], failures: list[str], timing: str, out: str | None) -> None:
+    """Appends the summary, the failing rays and the timing to the table's lines, prints them and writes
+    the whole to ``out`` when given."""
+    lines += ["", *summary, ""]
+    lines.append(f"failing rays ({len(failures)}):" if failures else "failing rays: none")
+    lines += ["  " + f for f in failures]
+    lines += ["", timing]
+    print("\n".join(lines[-(len(failures) + len(summary) + 5):]), flush=True)
+    if out:
+        Path(out).parent.mkdir(parents=True, exist_ok=True)
+        Path(out).write_text("\n".join(lines) + "\n")
+
+
 def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--taus", type=float, nargs="+", default=[0.1, 1.0, 5.0, 20.0, 50.0])
@@ -291,23 +311,12 @@ def main() -> None:
                          f"{st['max_rel']:+8.2%} {st['med_z']:7.2f} {st['max_z']:7.1f} {st['med_se']:7.2%} "
                          f"{st['noisy']:5d} {n_fail:4d}")
             print(lines[-1], flush=True)
-            for i in np.nonzero(st["fail"])[0]:
-                failures.append(f"tau {tau:g} g {g:g} {name:>6} {labels[i]:<30} solver {mine[i, c]:.4e} "
-                                f"Mitsuba {ref[i, c]:.4e} +- {se[i, c]:.1e}  rel {st['rel'][i]:+.2%}  "
-                                f"z {st['z'][i]:+.1f}")
-    lines.append("")
-    lines.append("over all cases: " + ", ".join(f"{c} {f}/{n} rays fail" for c, (n, f) in totals.items()))
-    lines.append("")
-    lines.append(f"failing rays ({len(failures)}):" if failures else "failing rays: none")
-    lines += ["  " + f for f in failures]
+            case = f"tau {tau:g} g {g:g} {name:>6}"
+            failures += failing_rays(case, labels, st, mine[:, c], ref[:, c], se[:, c], "Mitsuba")
     total = time.perf_counter() - t_start
-    lines.append("")
-    lines.append(f"timing: solver {t_solver:.0f} s, Mitsuba {t_mitsuba:.0f} s, total {total:.0f} s "
-                 f"({total / 60:.1f} min, {args.threads} threads)")
-    print("\n".join(lines[-(len(failures) + 6):]), flush=True)
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text("\n".join(lines) + "\n")
+    finish(lines, ["over all cases: " + ", ".join(f"{c} {f}/{n} rays fail" for c, (n, f) in totals.items())],
+           failures, f"timing: solver {t_solver:.0f} s, Mitsuba {t_mitsuba:.0f} s, total {total:.0f} s "
+           f"({total / 60:.1f} min, {args.threads} threads)", args.out)
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)
         Path(args.json).write_text(json.dumps({

@@ -44,7 +44,16 @@ for _dir in (HERE, HERE.parent / "tests"):
         sys.path.insert(0, str(_dir))
 
 import sphere_paths as sp  # noqa: E402
-from sphere_against_mitsuba import FLOOR, REL_TOL, SUN, Z_TOL, compare, sweep_rays  # noqa: E402
+from sphere_against_mitsuba import (  # noqa: E402
+    FLOOR,
+    REL_TOL,
+    SUN,
+    Z_TOL,
+    compare,
+    failing_rays,
+    finish,
+    sweep_rays,
+)
 
 COLUMNS = ["k=1", "k=2", "k=3", "total"]
 
@@ -111,26 +120,15 @@ def main() -> None:
                          f"{st['max_rel']:+8.2%} {st['med_z']:7.2f} {st['max_z']:7.1f} {n_fail:4d} "
                          f"{n_uniform if c < 3 else '-':>7}")
             print(lines[-1], flush=True)
-            for i in np.nonzero(st["fail"])[0]:
-                failures.append(f"tau {tau:g} g {g:g} {name:>6} {labels[i]:<30} solver {mine[i, c]:.4e} "
-                                f"tracer {ref[i, c]:.4e} +- {se[i, c]:.1e}  rel {st['rel'][i]:+.2%}  "
-                                f"z {st['z'][i]:+.1f}")
-    lines.append("")
-    lines.append("over all cases: " + ", ".join(
-        f"{c} {f}/{n} rays fail" + (f" ({u} with uniform polar nodes)" if c != "total" else "")
-        for c, (n, f, u) in totals.items()))
-    lines.append("most orders a tracer path took: " + ", ".join(f"{k} {v}" for k, v in most_orders.items()))
-    lines.append("")
-    lines.append(f"failing rays ({len(failures)}):" if failures else "failing rays: none")
-    lines += ["  " + f for f in failures]
+            case = f"tau {tau:g} g {g:g} {name:>6}"
+            failures += failing_rays(case, labels, st, mine[:, c], ref[:, c], se[:, c], "tracer")
     elapsed = time.perf_counter() - t_start
-    lines.append("")
-    lines.append(f"timing: solver {t_solver:.0f} s, tracer {t_tracer:.0f} s, total {elapsed:.0f} s "
-                 f"({elapsed / 60:.1f} min)")
-    print("\n".join(lines[-(len(failures) + 6):]), flush=True)
-    if args.out:
-        Path(args.out).parent.mkdir(parents=True, exist_ok=True)
-        Path(args.out).write_text("\n".join(lines) + "\n")
+    summary = ["over all cases: " + ", ".join(
+        f"{c} {f}/{n} rays fail" + (f" ({u} with uniform polar nodes)" if c != "total" else "")
+        for c, (n, f, u) in totals.items()),
+        "most orders a tracer path took: " + ", ".join(f"{k} {v}" for k, v in most_orders.items())]
+    finish(lines, summary, failures, f"timing: solver {t_solver:.0f} s, tracer {t_tracer:.0f} s, total "
+           f"{elapsed:.0f} s ({elapsed / 60:.1f} min)", args.out)
 
 
 if __name__ == "__main__":

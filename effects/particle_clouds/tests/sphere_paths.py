@@ -131,16 +131,32 @@ def _unit(v: np.ndarray) -> np.ndarray:
 # Camera paths
 
 
+def _camera_rays(sun: np.ndarray, origins: np.ndarray,
+                 dirs: np.ndarray) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+    """The unit sun, the rays as float64 (n, 3) with unit directions, their entry distances and chords
+    (0 for rays that miss)."""
+    sun = _unit(sun).reshape(3)
+    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
+    dirs = _unit(np.asarray(dirs, dtype=np.float64).reshape(-1, 3))
+    t0, t1 = chords(origins, dirs)
+    return sun, origins, dirs, t0, np.maximum(t1 - t0, 0.0)
+
+
+def _first_collisions(tau: float, chord: np.ndarray, t0: np.ndarray, origins: np.ndarray, dirs: np.ndarray,
+                      r: np.ndarray, rng: np.random.Generator) -> tuple[np.ndarray, np.ndarray]:
+    """The paths' first collisions forced inside their rays' chords (rays ``r``): the points and the
+    weights 1 - exp(-tau chord) (the distance from tau exp(-tau s) / (1 - exp(-tau chord)))."""
+    w = -np.expm1(-tau * chord[r])
+    s = -np.log1p(-rng.random(len(r)) * w) / tau
+    return origins[r] + (t0[r] + s)[:, None] * dirs[r], w
+
+
 def radiance_by_order(tau: float, g: float, sun: np.ndarray, origins: np.ndarray, dirs: np.ndarray,
                       orders: int = 18, paths: int = 4096, seed: int = 0) -> tuple[np.ndarray, np.ndarray]:
     """Mean and standard error of L_k along each ray for k = 1..orders, arrays (n_rays, orders), from
     ``paths`` backward paths per ray (module docstring). Rays that miss: 0 with standard error 0."""
-    sun = _unit(sun).reshape(3)
-    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
-    dirs = _unit(np.asarray(dirs, dtype=np.float64).reshape(-1, 3))
+    sun, origins, dirs, t0, chord = _camera_rays(sun, origins, dirs)
     n = len(dirs)
-    t0, t1 = chords(origins, dirs)
-    chord = np.maximum(t1 - t0, 0.0)
     hit = np.nonzero(chord > 0.0)[0]
     s1 = np.zeros((n, orders))
     s2 = np.zeros((n, orders))
@@ -148,10 +164,7 @@ def radiance_by_order(tau: float, g: float, sun: np.ndarray, origins: np.ndarray
     ray_of_path = np.repeat(hit, paths)
     for start in range(0, len(ray_of_path), CHUNK):
         r = ray_of_path[start:start + CHUNK]
-        # forced first collision inside the chord: s from tau exp(-tau s) / (1 - exp(-tau c))
-        w = -np.expm1(-tau * chord[r])
-        s = -np.log1p(-rng.random(len(r)) * w) / tau
-        x = origins[r] + (t0[r] + s)[:, None] * dirs[r]
+        x, w = _first_collisions(tau, chord, t0, origins, dirs, r, rng)
         d = dirs[r]
         for k in range(orders):
             nee = w * hg_phase(d @ sun, g) * np.exp(-tau * exit_distance(x, sun))
@@ -181,12 +194,8 @@ def radiance_all_orders(tau: float, g: float, sun: np.ndarray, origins: np.ndarr
     left the sphere (no cut, no roulette; with albedo 1 the weight never changes). A thick isotropic
     sphere's shadowed side is lit by paths of thousands of scatterings (tau = 50, g = 0: up to about
     9000); about 90 s per 1.6 million paths there on one core."""
-    sun = _unit(sun).reshape(3)
-    origins = np.asarray(origins, dtype=np.float64).reshape(-1, 3)
-    dirs = _unit(np.asarray(dirs, dtype=np.float64).reshape(-1, 3))
+    sun, origins, dirs, t0, chord = _camera_rays(sun, origins, dirs)
     n = len(dirs)
-    t0, t1 = chords(origins, dirs)
-    chord = np.maximum(t1 - t0, 0.0)
     hit = np.nonzero(chord > 0.0)[0]
     s1, s2 = np.zeros(n), np.zeros(n)
     rng = np.random.default_rng(seed)
@@ -196,9 +205,7 @@ def radiance_all_orders(tau: float, g: float, sun: np.ndarray, origins: np.ndarr
         r = ray_of_path[start:start + CHUNK]
         alive = np.arange(len(r))  # the paths still inside, by index into r
         total = np.zeros(len(r))  # each path's summed next-event estimates
-        w = -np.expm1(-tau * chord[r])  # the forced first collision's weight
-        s = -np.log1p(-rng.random(len(r)) * w) / tau
-        x = origins[r] + (t0[r] + s)[:, None] * dirs[r]
+        x, w = _first_collisions(tau, chord, t0, origins, dirs, r, rng)
         d = dirs[r]
         order = 0
         while len(alive):
