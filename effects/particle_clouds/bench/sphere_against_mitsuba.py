@@ -49,11 +49,16 @@ rays re-checked by hand against sphere_paths' closed-form single scattering and 
 tracer): order 1's failures at tau 20 and 50 are Mitsuba's (the solver equals the closed form to 4
 digits; Mitsuba is 2-12 % low on rays entering where the sun grazes, even at radius 100); at tau 0.1,
 g 0.9 the failing orders 2 and 3 (radiances near the 1e-3 floor, front- and side-lit) agree with
-sphere_paths, Mitsuba being low there with heavy tails its batch-means error misses; the total's
-remaining failures are the solver's (physics.md section 2.6: the shadowed side of tau = 50, g = 0).
+sphere_paths, Mitsuba being low there with heavy tails its batch-means error misses. Mitsuba runs
+without Russian roulette (sphere_mitsuba.RR_DEPTH): with roulette after 2000 vertices its total on a
+tau = 50, g = 0 sphere's shadowed side was 30-50 % low against sphere_paths followed to the end
+(sphere_against_tracer.py). The total's remaining failures (physics.md section 2.6): at tau = 50 the
+deepest shadow, 1e-3 of the brightest, 12-24 % darker than Mitsuba (within the numpy tracer's larger
+noise there), and g = 0.9 (the direction grid).
 
-Runtime with --spp 262144 (15 cases, 25 rays, five depths): 22.5 minutes on 2 cores shared with a
-test run (solver 591 s, Mitsuba 756 s); the last line of the text file. Mitsuba's time is
+Runtime with --spp 262144 (15 cases, 25 rays, five depths): 74 minutes on 2 cores shared with other
+benchmarks (solver 548 s, Mitsuba 3863 s: without roulette the thick spheres' paths run to thousands
+of scatterings); the last line of the text file. Mitsuba's time is
 proportional to --spp. --quick (tau 5, g 0.5, 65536 samples): about a minute.
 """
 

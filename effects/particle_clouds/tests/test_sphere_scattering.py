@@ -165,11 +165,12 @@ def test_light_entering_where_the_sun_grazes_matches_the_path_tracer(tau: float,
 @pytest.mark.slow
 @pytest.mark.parametrize(("tau", "g"), [(20.0, 0.0), (20.0, 0.5)])
 def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float, g: float) -> None:
-    # Every order, lit side to the sun's shadow, against Mitsuba 3 at unlimited depth (stored by
-    # bench/sphere_against_mitsuba.py --json with its standard errors): 2 % or 4 standard errors (the
-    # sweep's 3 leaves one ray of these 50 out, back-lit at the limb: -6.7 %, z = -3.1), on rays above
-    # 1e-3 of the brightest. The shadowed side is where linear interpolation between nodes diffused
-    # light (physics.md section 2.3: 22 of these 25 rays at g = 0 failed, by up to 2.4x).
+    # Every order, lit side to the sun's shadow, against Mitsuba 3 at unlimited depth without Russian
+    # roulette (stored by bench/sphere_against_mitsuba.py --json with its standard errors): 2 % or 4
+    # standard errors on rays above 1e-3 of the brightest (all 50 are within the sweep's 3; the
+    # largest, -7.2 % at z = -2.7, on the shadowed limb). The shadowed side is where linear
+    # interpolation between nodes diffused light (physics.md section 2.3: 22 of these 25 rays at g = 0
+    # failed, by up to 2.4x).
     ref = json.loads((Path(__file__).resolve().parent / "sphere_mitsuba_reference.json").read_text())
     case = next(c for c in ref["cases"] if c["tau"] == tau and c["g"] == g)
     total = ref["columns"].index("total")
