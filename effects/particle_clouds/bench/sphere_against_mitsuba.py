@@ -52,7 +52,8 @@ g 0.9 the failing orders 2 and 3 (radiances near the 1e-3 floor, front- and side
 sphere_paths, Mitsuba being low there with heavy tails its batch-means error misses. Mitsuba runs
 without Russian roulette (sphere_mitsuba.RR_DEPTH): with roulette after 2000 vertices its total on a
 tau = 50, g = 0 sphere's shadowed side was 30-50 % low against sphere_paths followed to the end
-(sphere_against_tracer.py). The total's remaining failures (physics.md section 2.6): at tau = 50 the
+(a one-off comparison, physics.md 2.6; sphere_against_tracer.py). The total's remaining
+failures (physics.md section 2.6): at tau = 50 the
 deepest shadow, 1e-3 of the brightest, 12-24 % darker than Mitsuba (within the numpy tracer's larger
 noise there), and g = 0.9 (the direction grid).
 

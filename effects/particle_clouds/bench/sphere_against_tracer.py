@@ -8,7 +8,8 @@ Why a second outside reference beside Mitsuba (sphere_against_mitsuba.py). The t
 thick isotropic particle's shadowed side comes from paths of thousands of scatterings; the numpy
 tracer of effects/particle_clouds/tests/sphere_paths.py follows every camera path until it leaves
 (``radiance_all_orders``: no cut, no roulette, up to about 9000 orders at tau = 50, g = 0), where
-Mitsuba with Russian roulette after 2000 vertices came out 30-50 % dark on those rays. It also
+Mitsuba with Russian roulette after 2000 vertices came out 30-50 % dark on those rays (a one-off
+comparison, physics.md 2.6). It also
 has lower noise per sample (next-event estimation with the exact transmittance, a forced first
 collision), so orders 1-3 are resolved to about 1 % on 2^17 paths.
 

@@ -15,7 +15,7 @@ roulette would keep a path with probability 0.95 per vertex and weight the survi
 That is unbiased on paper and biased in any real run: the light of a thick isotropic sphere's
 shadowed side takes thousands of scatterings to get there (the numpy tracer's camera paths at
 tau = 50, g = 0 run to 9000 orders), and with fit_octaves' RR_DEPTH = 2000 Mitsuba came out 30-50 %
-dark on those rays against sphere_paths. Scene: a
+(a one-off comparison, physics.md 2.6) dark on those rays against sphere_paths. Scene: a
 ``sphere`` (radius 1, centre 0; --radius scales the world) with a ``null`` BSDF and an interior
 ``homogeneous`` medium (sigma_t = tau, albedo 1, ``hg`` phase of g; ``isotropic`` for g = 0, as
 fit_octaves does), a ``directional`` emitter of direction -sun and irradiance 1, nothing else.
