@@ -327,6 +327,12 @@ airlight::ParticleTableShape parse_particle_table_shape(const py::dict& keys) {
             (key == "tau_min" ? shape.tau_min : shape.tau_max) = item.second.cast<double>();
             continue;
         }
+        if (key == "dense_terminator") {
+            if (!py::isinstance<py::bool_>(item.second))
+                throw py::type_error("shape.dense_terminator: must be true or false");
+            shape.dense_terminator = item.second.cast<bool>();
+            continue;
+        }
         int* field = key == "entry"          ? &shape.entry
                      : key == "view_zenith"  ? &shape.view_zenith
                      : key == "view_azimuth" ? &shape.view_azimuth

@@ -9,6 +9,7 @@
 set(EFFECT_SOURCES sphere_scattering.cpp particle_table.cpp particle_field.cpp particle_keys.cpp
     particle_frame.cpp)
 set(EFFECT_SCENE_KEYS particle_clouds)
+set(EFFECT_GLSL_MATH particle_table_math.glsl)  # the table's node coordinates, shared with the CPU
 set(EFFECT_GLSL_PIXEL particle_clouds.glsl)
 set(EFFECT_GLSL_TERMS particle_terms.glsl)
 set(EFFECT_HOOKS

@@ -71,9 +71,8 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
     }
     vec3 f;
     ivec3 node;
-    node.x = particle_node(precise_acos(cos_entry) / PI * float(shape.x - 1), shape.x, f.x);
-    float zenith = precise_acos(cos_view) / (0.5f * PI);
-    node.y = particle_node((1.0f - pow(max(1.0f - zenith, 0.0f), 1.0f / 1.5f)) * float(shape.y - 1), shape.y, f.y);
+    node.x = particle_node(particle_entry_coordinate(precise_acos(cos_entry), taus.w != 0.0f) * float(shape.x - 1), shape.x, f.x);
+    node.y = particle_node(particle_zenith_coordinate(precise_acos(cos_view)) * float(shape.y - 1), shape.y, f.y);
     node.z = particle_node(psi / PI * float(shape.z - 1), shape.z, f.z);
     float ft;
     int m = particle_node(log(max(tau, 1.0e-30f) / taus.x) / taus.y * float(shape.w - 1), shape.w, ft);

@@ -19,8 +19,9 @@ namespace airlight {
 namespace {
 
 // Bumped whenever the solver or the table's layout changes: older files on disk are ignored.
-constexpr int TABLE_FILE_VERSION = 5;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
-                                       // 4, 5: polar nodes graded toward the terminator (2.14)
+constexpr int TABLE_FILE_VERSION = 6;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
+                                       // 4, 5: polar nodes graded toward the terminator (2.14); 6: entry angles
+                                       // dense across the terminator (3.2)
 
 // Where built tables are kept: $AIRLIGHT_CACHE_DIR, else $XDG_CACHE_HOME/airlight, else
 // ~/.cache/airlight; empty (no disk cache) when none can be named.
@@ -113,7 +114,8 @@ void pack_particle_clouds_frame(const Scene& scene, FrameData& data) {
     const ParticleTableShape shape = particle_table_shape(scene.quality.particle_table);
     shader::ParticleCloudsGpu& g = data.frame.particle_clouds;
     g.table_shape = glm::ivec4(shape.entry, shape.view_zenith, shape.view_azimuth, shape.taus);
-    g.table_taus = glm::vec4(float(shape.tau_min), float(std::log(shape.tau_max / shape.tau_min)), c.g, 0.0f);
+    g.table_taus = glm::vec4(float(shape.tau_min), float(std::log(shape.tau_max / shape.tau_min)), c.g,
+                             shape.dense_terminator ? 1.0f : 0.0f);
     g.tiles = glm::ivec4(tiles.tiles_x, tiles.tiles_y, int(field.particles.size()), tile_size);
     if (const ParticleShadowMap& m = field.shadow_map; m.size > 0) {
         auto t = std::make_shared<Table2D>();

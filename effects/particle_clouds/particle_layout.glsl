@@ -12,7 +12,8 @@ CONST float PARTICLE_OPAQUE = 1.0e-4f;
 
 struct ParticleCloudsGpu {
     ivec4 table_shape;  // the lighting table's nodes: x entry angles, y view zeniths, z view azimuths, w optical radii
-    vec4 table_taus;    // x: the smallest optical radius, y: ln(largest / smallest), z: the droplets' g, w: unused
+    vec4 table_taus;    // x: the smallest optical radius, y: ln(largest / smallest), z: the droplets' g,
+                        // w: 1 where the entry angles are dense across the terminator (particle_table_math.glsl)
     ivec4 tiles;        // x, y: screen tiles along x and down, z: particles, w: a tile's edge in pixels
     vec4 shadow_map;    // the shadow below (physics.md section 5): x, y: its corner's x, z (m), z: 1 / its extent (1/m),
                         // w: the plane's height (m)

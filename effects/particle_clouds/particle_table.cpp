@@ -8,6 +8,7 @@
 #include <string>
 
 #include "numerics.hpp"
+#include "shader_cpp.hpp"
 
 namespace airlight {
 namespace {
@@ -47,11 +48,10 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
         const double tau = slice_tau(m);
         const SphereScattering sphere(tau, g, shape.grid);
         numerics::parallel_for(E * Z, [&](int ez) {
-            // Eq. 3.1: the node's ray in the solver's frame (sun on +z), entering at P = n.
-            // The view's zenith at node s in [0, 1] is (pi / 2) (1 - (1 - s)^1.5) (eq. 3.2): dense near
-            // grazing, where the chord 2 cos(zenith) and the light along it change fastest.
-            const double s = double(ez % Z) / (Z - 1);
-            const double th = kPi * (ez / Z) / (E - 1), ze = 0.5 * kPi * (1.0 - std::pow(1.0 - s, 1.5));
+            // Eq. 3.1: the node's ray in the solver's frame (sun on +z), entering at P = n, at the entry
+            // angle and view zenith of eq. 3.2's nodes (particle_table_math.glsl).
+            const double th = shader::particle_entry_angle(float(ez / Z) / float(E - 1), shape.dense_terminator);
+            const double ze = shader::particle_zenith_angle(float(ez % Z) / float(Z - 1));
             const double n[3] = {std::sin(th), 0.0, std::cos(th)}, t[3] = {-std::cos(th), 0.0, std::sin(th)};
             for (int a = 0; a < A; ++a) {
                 const double ps = kPi * a / (A - 1);
@@ -69,8 +69,7 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
 }
 
 ParticleTableShape particle_table_shape(ParticleTableQuality quality) {
-    ParticleTableShape shape;  // full: 12 optical radii (effects/particle_clouds/docs/table_resolution.txt)
-    shape.taus = 12;
+    ParticleTableShape shape;  // full (effects/particle_clouds/docs/table_resolution.txt)
     shape.grid.beyond = true;  // every order, not the source's 18 (physics.md section 2.7)
     if (quality == ParticleTableQuality::preview) {
         shape.entry = 16;
@@ -109,9 +108,10 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
     const int E = shape_.entry, Z = shape_.view_zenith, A = shape_.view_azimuth;
     int node[4];
     double frac[4];
-    node_and_fraction(std::acos(cos_entry) / kPi * (E - 1), E, node[0], frac[0]);
-    node_and_fraction((1.0 - std::pow(1.0 - std::acos(cos_view) / (0.5 * kPi), 1.0 / 1.5)) * (Z - 1), Z, node[1],
-                      frac[1]);
+    // Eq. 3.2: the nodes' coordinates (particle_table_math.glsl).
+    node_and_fraction(shader::particle_entry_coordinate(float(std::acos(cos_entry)), shape_.dense_terminator) * (E - 1),
+                      E, node[0], frac[0]);
+    node_and_fraction(shader::particle_zenith_coordinate(float(std::acos(cos_view))) * (Z - 1), Z, node[1], frac[1]);
     node_and_fraction(psi / kPi * (A - 1), A, node[2], frac[2]);
     // Eq. 3.2: the optical radius, log-uniform; below tau_min order 1 scales with tau and the rest with
     // tau^2 (thin particles), above tau_max the thickest slice stands.

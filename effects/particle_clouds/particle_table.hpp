@@ -13,14 +13,17 @@
 
 namespace airlight {
 
-// The table's nodes (uniform in each angle, log-uniform in the optical radius).
+// The table's nodes (eq. 3.2, particle_table_math.glsl: the entry angle dense across the terminator,
+// the view zenith dense near grazing, uniform in the azimuth, log-uniform in the optical radius).
 struct ParticleTableShape {
-    int entry = 32;         // the entry point's angle from the sun, [0, pi]
+    int entry = 64;         // the entry point's angle from the sun, [0, pi]
     int view_zenith = 16;   // the ray's angle from the inward normal there, [0, pi / 2]
     int view_azimuth = 32;  // its azimuth about the normal from the sun's side, [0, pi]
     int taus = 12;          // optical radii, log-uniform in [tau_min, tau_max]
     double tau_min = 0.1;
     double tau_max = 50.0;
+    // Entry angles dense across the terminator (eq. 3.2); false: uniform, for comparisons.
+    bool dense_terminator = true;
     int steps = 32;   // ray integral steps of each node (eq. 2.6)
     SphereGrid grid;  // the solver's grid at each optical radius
 };

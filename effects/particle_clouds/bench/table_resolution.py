@@ -10,13 +10,15 @@ checked against path tracers separately: test_sphere_scattering.py, sphere_again
 measured in two parts:
 
 1. the angles: tables of two optical radii (the tested radius and one above it) at several angular
-   resolutions, looked up at the tested radius (a node in tau, so only the angles interpolate), for
-   random rays over the whole sphere and random sun directions;
+   resolutions, with entry angles uniform or dense across the terminator (eq. 3.2), looked up at the
+   tested radius (a node in tau, so only the angles interpolate), for random rays over the whole
+   sphere and random sun directions;
 2. the optical radius: tables over [0.1, 50] with several numbers of radii, looked up at the
    geometric midpoints between their nodes (the worst place), against the solver at those radii.
 
-Errors are relative errors of the total radiance (order 1 plus orders 2..18) over the rays above
-1e-3 of the largest: median, 99th percentile and maximum. Build time and size per table.
+Errors are relative errors of the total radiance (every order, as the renderer's tables hold: the
+orders beyond 18 light a thick particle's shadowed side) over the rays above 1e-3 of the largest:
+median, 99th percentile and maximum. Build time and size per table.
 
 3. the build: the tables the renderer builds for quality.particle_table "full" and "preview"
    (every order, eq. 2.11), timed at --g (the presets' particles have g = 0.7).
@@ -87,50 +89,56 @@ def main() -> None:
     ap = argparse.ArgumentParser(description=__doc__, formatter_class=argparse.RawDescriptionHelpFormatter)
     ap.add_argument("--g", type=float, default=0.85)
     ap.add_argument("--rays", type=int, default=400)
-    ap.add_argument("--taus", type=float, nargs="+", default=[0.5, 5.0, 30.0])
+    ap.add_argument("--taus", type=float, nargs="+", default=[0.5, 5.0, 30.0, 50.0])
     parts = ["angles", "taus", "build"]
     ap.add_argument("--parts", nargs="+", default=parts, choices=parts)
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
-    grid = {"orders": 18}
+    grid = {"orders": 18, "beyond": True}
     origins, dirs, normals, suns = random_rays(args.rays, seed=1)
     lines = [f"Particle lighting table against the solver (g = {args.g}, {args.rays} random rays and suns, "
              "relative error of the total radiance over rays above 1e-3 of the largest)"]
     if "angles" in args.parts:
-        lines += ["", "1. the angles (tables at the tested optical radius: only the angles interpolate)",
-                  f"{'tau':>6} {'entry x zenith x azimuth':>25} {'median':>9} {'p99':>9} {'max':>9} "
-                  f"{'build s':>8}"]
+        lines += ["", "1. the angles (tables at the tested optical radius: only the angles interpolate; "
+                  "entry angles uniform or dense across the terminator)",
+                  f"{'tau':>6} {'entry x zenith x azimuth':>25} {'entry':>8} {'median':>9} {'p99':>9} "
+                  f"{'max':>9} {'build s':>8}"]
+        shapes = [((32, 16, 32), False), ((32, 16, 32), True), ((64, 16, 32), False), ((64, 16, 32), True),
+                  ((64, 32, 32), True)]
         for tau in args.taus:
             exact = direct(tau, args.g, origins, dirs, suns, grid)
-            for shape in [(16, 8, 16), (32, 16, 32), (48, 24, 48), (64, 32, 64)]:
+            for shape, dense in shapes:
                 t0 = time.perf_counter()
                 keys = {"entry": shape[0], "view_zenith": shape[1], "view_azimuth": shape[2], "taus": 2,
-                        "tau_min": tau, "tau_max": tau * 1.5, "grid": grid}
+                        "tau_min": tau, "tau_max": tau * 1.5, "dense_terminator": dense, "grid": grid}
                 table = core.ParticleTable(args.g, keys)
                 build = time.perf_counter() - t0
                 med, p99, mx = stats(lookup(table, tau, normals, dirs, suns), exact)
-                lines.append(f"{tau:6.1f} {'x'.join(map(str, shape)):>25} {med:9.2e} {p99:9.2e} {mx:9.2e} "
-                             f"{build:8.1f}")
+                layout = "dense" if dense else "uniform"
+                lines.append(f"{tau:6.1f} {'x'.join(map(str, shape)):>25} {layout:>8} "
+                             f"{med:9.2e} {p99:9.2e} {mx:9.2e} {build:8.1f}")
                 print(lines[-1], file=sys.stderr)
     if "taus" in args.parts:
         lines += ["", "2. the optical radius (tables over [0.1, 50], looked up halfway between nodes, "
                   "in log)",
-                  f"{'radii':>6} {'median':>9} {'p99':>9} {'max':>9} {'build s':>8} {'MiB':>6}"]
+                  f"{'radii':>6} {'median':>9} {'p99':>9} {'max':>9} {'build s':>8} {'MiB':>6} "
+                  f"{'worst p99 at tau':>17}"]
         for count in [12, 24]:
             t0 = time.perf_counter()
             table = core.ParticleTable(args.g, {"taus": count, "grid": grid})
             build = time.perf_counter() - t0
             nodes = 0.1 * (50.0 / 0.1) ** (np.arange(count) / (count - 1))
             mids = np.sqrt(nodes[:-1] * nodes[1:])[:: max(1, (count - 1) // 4)]
-            errs = []
+            errs, worst = [], (0.0, 0.0)
             for tau in mids:
                 exact = direct(float(tau), args.g, origins, dirs, suns, grid)
                 keep = exact > 1e-3 * exact.max()
                 looked_up = lookup(table, float(tau), normals, dirs, suns)
                 errs.append(np.abs(looked_up - exact)[keep] / exact[keep])
+                worst = max(worst, (float(np.percentile(errs[-1], 99)), float(tau)))
             rel = np.concatenate(errs)
             lines.append(f"{count:6d} {np.median(rel):9.2e} {np.percentile(rel, 99):9.2e} {rel.max():9.2e} "
-                         f"{build:8.1f} {table.bytes / 2**20:6.2f}")
+                         f"{build:8.1f} {table.bytes / 2**20:6.2f} {worst[0]:8.2e} at {worst[1]:5.2f}")
             print(lines[-1], file=sys.stderr)
     if "build" in args.parts:
         lines += ["", f"3. the renderer's tables at g = {args.g} (every order)",

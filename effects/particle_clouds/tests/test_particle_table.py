@@ -36,6 +36,24 @@ def test_the_table_interpolates_the_solver_between_its_angles() -> None:
 
 
 @pytest.mark.slow
+def test_entry_angles_dense_across_the_terminator_beat_uniform_ones_on_a_thick_particle() -> None:
+    # Eq. 3.2: a thick particle's light falls steeply across the terminator (and order 1 peaks on the
+    # rays grazing it there); the same number of entry nodes placed densely there interpolate it better.
+    g, tau = 0.85, 20.0
+    grid = {**GRID, "polar": 32, "beyond": True}
+    origins, dirs, normals, suns = analysis.random_rays(600, seed=9)
+    entry = np.degrees(np.arccos(np.clip((normals * suns).sum(axis=1), -1.0, 1.0)))
+    near = (entry > 80.0) & (entry < 100.0)
+    exact = analysis.direct(tau, g, origins[near], dirs[near], suns[near], grid)
+    p99 = {}
+    for dense in (False, True):
+        table = airlight._core.ParticleTable(g, {"entry": 24, "taus": 2, "tau_min": tau, "tau_max": 2 * tau,
+                                                 "dense_terminator": dense, "grid": grid})
+        p99[dense] = analysis.stats(lookup_all(table, tau, normals[near], dirs[near], suns[near]), exact)[1]
+    assert p99[True] < 0.5 * p99[False], p99
+
+
+@pytest.mark.slow
 def test_the_table_interpolates_the_solver_between_its_optical_radii() -> None:
     g = 0.5
     origins, dirs, normals, suns = analysis.random_rays(150, seed=8)
@@ -62,7 +80,8 @@ def test_a_thin_particle_scales_from_the_thinnest_slice() -> None:
 @pytest.mark.parametrize(("shape", "field"), [({"entry": 1}, "shape.entry"), ({"taus": 1}, "shape.taus"),
                                               ({"tau_min": 5.0, "tau_max": 1.0}, "shape.tau_min"),
                                               ({"colour": 3}, "shape.colour"),
+                                              ({"dense_terminator": 1}, "shape.dense_terminator"),
                                               ({"grid": {"radii": 0}}, "grid.radii")])
 def test_a_bad_table_shape_is_a_clear_error(shape: dict, field: str) -> None:
-    with pytest.raises(ValueError, match=field):
+    with pytest.raises((ValueError, TypeError), match=field):
         airlight._core.ParticleTable(0.5, shape)
