@@ -71,7 +71,7 @@ float particle_table_light(float tau, vec3 n, vec3 v, vec3 s) {
     }
     vec3 f;
     ivec3 node;
-    node.x = particle_node(particle_entry_coordinate(precise_acos(cos_entry), taus.w != 0.0f) * float(shape.x - 1), shape.x, f.x);
+    node.x = particle_node(particle_entry_index(precise_acos(cos_entry), shape.x, taus.w != 0.0f), shape.x, f.x);
     node.y = particle_node(particle_zenith_coordinate(precise_acos(cos_view)) * float(shape.y - 1), shape.y, f.y);
     node.z = particle_node(psi / PI * float(shape.z - 1), shape.z, f.z);
     float ft;

@@ -19,8 +19,8 @@ namespace airlight {
 namespace {
 
 // Bumped whenever the solver or the table's layout changes: older files on disk are ignored.
-constexpr int TABLE_FILE_VERSION = 6;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
-                                       // 4, 5: polar nodes graded toward the terminator (2.14); 6: entry angles
+constexpr int TABLE_FILE_VERSION = 7;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
+                                       // 4, 5: polar nodes graded toward the terminator (2.14); 6, 7: entry angles
                                        // dense across the terminator (3.2)
 
 // Where built tables are kept: $AIRLIGHT_CACHE_DIR, else $XDG_CACHE_HOME/airlight, else

@@ -27,7 +27,7 @@ void validate_particle_table_shape(const ParticleTableShape& shape) {
                                         std::to_string(lo) + ", " + std::to_string(hi) + "], got " +
                                         std::to_string(value));
     };
-    check("entry", shape.entry, 2, 512);
+    check("entry", shape.entry, shape.dense_terminator ? shader::PARTICLE_DENSE_ENTRY_MIN : 2, 512);
     check("view_zenith", shape.view_zenith, 2, 512);
     check("view_azimuth", shape.view_azimuth, 2, 512);
     check("taus", shape.taus, 2, 256);
@@ -50,7 +50,7 @@ ParticleTable::ParticleTable(double g, const ParticleTableShape& shape) : g_(g),
         numerics::parallel_for(E * Z, [&](int ez) {
             // Eq. 3.1: the node's ray in the solver's frame (sun on +z), entering at P = n, at the entry
             // angle and view zenith of eq. 3.2's nodes (particle_table_math.glsl).
-            const double th = shader::particle_entry_angle(float(ez / Z) / float(E - 1), shape.dense_terminator);
+            const double th = shader::particle_entry_angle(float(ez / Z), E, shape.dense_terminator);
             const double ze = shader::particle_zenith_angle(float(ez % Z) / float(Z - 1));
             const double n[3] = {std::sin(th), 0.0, std::cos(th)}, t[3] = {-std::cos(th), 0.0, std::sin(th)};
             for (int a = 0; a < A; ++a) {
@@ -109,8 +109,8 @@ std::array<double, 2> ParticleTable::lookup(double tau, const double normal[3], 
     int node[4];
     double frac[4];
     // Eq. 3.2: the nodes' coordinates (particle_table_math.glsl).
-    node_and_fraction(shader::particle_entry_coordinate(float(std::acos(cos_entry)), shape_.dense_terminator) * (E - 1),
-                      E, node[0], frac[0]);
+    node_and_fraction(shader::particle_entry_index(float(std::acos(cos_entry)), E, shape_.dense_terminator), E, node[0],
+                      frac[0]);
     node_and_fraction(shader::particle_zenith_coordinate(float(std::acos(cos_view))) * (Z - 1), Z, node[1], frac[1]);
     node_and_fraction(psi / kPi * (A - 1), A, node[2], frac[2]);
     // Eq. 3.2: the optical radius, log-uniform; below tau_min order 1 scales with tau and the rest with

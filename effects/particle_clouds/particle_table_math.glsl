@@ -8,42 +8,55 @@
 // angle from the sun, with these relative densities: 1 on the lit side, 3
 // across the terminator, where a thick particle's light falls steeply and
 // order 1 peaks on the grazing rays, 2 into the shadow and 1 on the far side
-// (effects/particle_clouds/docs/table_resolution.txt).
+// (effects/particle_clouds/docs/table_resolution.txt). Each span holds a
+// whole number of node intervals, so that a node lies on every span's edge
+// and the interpolation between two nodes is linear in the angle.
 CONST float PARTICLE_TERMINATOR_FROM = 1.3962634f;  // 80 degrees
 CONST float PARTICLE_TERMINATOR_TO = 1.7453293f;    // 100 degrees
 CONST float PARTICLE_SHADOW_TO = 2.4434610f;        // 140 degrees
 CONST float PARTICLE_TERMINATOR_DENSITY = 3.0f;
 CONST float PARTICLE_SHADOW_DENSITY = 2.0f;
+// The fewest entry nodes of the dense layout (an interval per span).
+CONST int PARTICLE_DENSE_ENTRY_MIN = 5;
 
-// The number of nodes' worth of density from 0 to the entry angle (radians
-// weighted by the spans' densities).
-INLINE float particle_entry_weight(float angle) {
-    float lit = min(angle, PARTICLE_TERMINATOR_FROM);
-    float terminator = clamp(angle, PARTICLE_TERMINATOR_FROM, PARTICLE_TERMINATOR_TO) - PARTICLE_TERMINATOR_FROM;
-    float shadow = clamp(angle, PARTICLE_TERMINATOR_TO, PARTICLE_SHADOW_TO) - PARTICLE_TERMINATOR_TO;
-    float far_side = max(angle, PARTICLE_SHADOW_TO) - PARTICLE_SHADOW_TO;
-    return lit + PARTICLE_TERMINATOR_DENSITY * terminator + PARTICLE_SHADOW_DENSITY * shadow + far_side;
+// The node indices at the spans' edges 80, 100 and 140 degrees for n entry
+// nodes (the last node, n - 1, is at pi): each span's share of the n - 1
+// intervals in proportion to its length times its density, rounded, at least one.
+INLINE vec3 particle_entry_edges(int n) {
+    float lit = PARTICLE_TERMINATOR_FROM;
+    float terminator = PARTICLE_TERMINATOR_DENSITY * (PARTICLE_TERMINATOR_TO - PARTICLE_TERMINATOR_FROM);
+    float shadow = PARTICLE_SHADOW_DENSITY * (PARTICLE_SHADOW_TO - PARTICLE_TERMINATOR_TO);
+    float per_weight = float(n - 1) / (lit + terminator + shadow + (PI - PARTICLE_SHADOW_TO));
+    float a = max(1.0f, floor(lit * per_weight + 0.5f));
+    float b = a + max(1.0f, floor(terminator * per_weight + 0.5f));
+    float c = min(b + max(1.0f, floor(shadow * per_weight + 0.5f)), float(n - 2));
+    return vec3(a, b, c);
 }
 
-// The entry angle (radians from the sun, [0, pi]) as a coordinate in [0, 1]:
-// node i of n lies at coordinate i / (n - 1). Uniform in the angle without
-// dense_terminator (ParticleTableShape::dense_terminator, for comparisons).
-INLINE float particle_entry_coordinate(float angle, bool dense_terminator) {
-    if (!dense_terminator) return clamp(angle / PI, 0.0f, 1.0f);
-    return particle_entry_weight(angle) / particle_entry_weight(PI);
+// The entry angle (radians from the sun, [0, pi]) as a fractional node index
+// in [0, n - 1]. Uniform in the angle without dense_terminator
+// (ParticleTableShape::dense_terminator, for comparisons).
+INLINE float particle_entry_index(float angle, int n, bool dense_terminator) {
+    float x = clamp(angle, 0.0f, PI);
+    if (!dense_terminator) return x / PI * float(n - 1);
+    vec3 edge = particle_entry_edges(n);
+    if (x <= PARTICLE_TERMINATOR_FROM) return x / PARTICLE_TERMINATOR_FROM * edge.x;
+    if (x <= PARTICLE_TERMINATOR_TO)
+        return mix(edge.x, edge.y, (x - PARTICLE_TERMINATOR_FROM) / (PARTICLE_TERMINATOR_TO - PARTICLE_TERMINATOR_FROM));
+    if (x <= PARTICLE_SHADOW_TO)
+        return mix(edge.y, edge.z, (x - PARTICLE_TERMINATOR_TO) / (PARTICLE_SHADOW_TO - PARTICLE_TERMINATOR_TO));
+    return mix(edge.z, float(n - 1), (x - PARTICLE_SHADOW_TO) / (PI - PARTICLE_SHADOW_TO));
 }
 
-// The inverse: the entry angle at a coordinate in [0, 1].
-INLINE float particle_entry_angle(float coordinate, bool dense_terminator) {
-    if (!dense_terminator) return clamp(coordinate, 0.0f, 1.0f) * PI;
-    float w = clamp(coordinate, 0.0f, 1.0f) * particle_entry_weight(PI);
-    float at_from = PARTICLE_TERMINATOR_FROM;
-    float at_to = particle_entry_weight(PARTICLE_TERMINATOR_TO);
-    float at_shadow = particle_entry_weight(PARTICLE_SHADOW_TO);
-    if (w <= at_from) return w;
-    if (w <= at_to) return PARTICLE_TERMINATOR_FROM + (w - at_from) / PARTICLE_TERMINATOR_DENSITY;
-    if (w <= at_shadow) return PARTICLE_TERMINATOR_TO + (w - at_to) / PARTICLE_SHADOW_DENSITY;
-    return PARTICLE_SHADOW_TO + (w - at_shadow);
+// The inverse: the entry angle of node i (or of a fractional index).
+INLINE float particle_entry_angle(float i, int n, bool dense_terminator) {
+    float x = clamp(i, 0.0f, float(n - 1));
+    if (!dense_terminator) return x / float(n - 1) * PI;
+    vec3 edge = particle_entry_edges(n);
+    if (x <= edge.x) return x / edge.x * PARTICLE_TERMINATOR_FROM;
+    if (x <= edge.y) return mix(PARTICLE_TERMINATOR_FROM, PARTICLE_TERMINATOR_TO, (x - edge.x) / (edge.y - edge.x));
+    if (x <= edge.z) return mix(PARTICLE_TERMINATOR_TO, PARTICLE_SHADOW_TO, (x - edge.y) / (edge.z - edge.y));
+    return mix(PARTICLE_SHADOW_TO, PI, (x - edge.z) / (float(n - 1) - edge.z));
 }
 
 // Eq. 3.2: the view's zenith (from the inward normal, [0, pi / 2]) at a

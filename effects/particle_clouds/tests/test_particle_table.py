@@ -68,7 +68,7 @@ def test_a_thin_particle_scales_from_the_thinnest_slice() -> None:
     # Below tau_min order 1 grows as tau and the rest as tau^2: half the optical radius, half the
     # single scattering and a quarter of the rest.
     grid = {**GRID, "orders": 2}
-    table = airlight._core.ParticleTable(0.5, {"entry": 4, "view_zenith": 3, "view_azimuth": 4, "taus": 2,
+    table = airlight._core.ParticleTable(0.5, {"entry": 5, "view_zenith": 3, "view_azimuth": 4, "taus": 2,
                                                "tau_min": 0.2, "tau_max": 0.4, "grid": grid})
     normal, view, sun = np.array([[0.0, 0.0, 1.0]]), np.array([[0.0, 0.0, -1.0]]), np.array([0.0, 0.6, 0.8])
     at_min = table.lookup(np.array([0.2]), normal, view, sun)[0]
