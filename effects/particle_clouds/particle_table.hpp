@@ -17,7 +17,7 @@ namespace airlight {
 // the view zenith dense near grazing, uniform in the azimuth, log-uniform in the optical radius).
 struct ParticleTableShape {
     int entry = 64;         // the entry point's angle from the sun, [0, pi]
-    int view_zenith = 16;   // the ray's angle from the inward normal there, [0, pi / 2]
+    int view_zenith = 32;   // the ray's angle from the inward normal there, [0, pi / 2]
     int view_azimuth = 32;  // its azimuth about the normal from the sun's side, [0, pi]
     int taus = 12;          // optical radii, log-uniform in [tau_min, tau_max]
     double tau_min = 0.1;

@@ -92,6 +92,7 @@ def main() -> None:
     ap.add_argument("--taus", type=float, nargs="+", default=[0.5, 5.0, 30.0, 50.0])
     parts = ["angles", "taus", "build"]
     ap.add_argument("--parts", nargs="+", default=parts, choices=parts)
+    ap.add_argument("--slices", type=int, nargs="+", default=[12], help="numbers of optical radii (part 2)")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
     grid = {"orders": 18, "beyond": True}
@@ -123,7 +124,7 @@ def main() -> None:
                   "in log)",
                   f"{'radii':>6} {'median':>9} {'p99':>9} {'max':>9} {'build s':>8} {'MiB':>6} "
                   f"{'worst p99 at tau':>17}"]
-        for count in [12, 24]:
+        for count in args.slices:
             t0 = time.perf_counter()
             table = core.ParticleTable(args.g, {"taus": count, "grid": grid})
             build = time.perf_counter() - t0
