@@ -296,6 +296,12 @@ airlight::SphereGrid parse_sphere_grid(const py::dict& keys) {
             (key == "beyond" ? grid.beyond : grid.graded_polar) = item.second.cast<bool>();
             continue;
         }
+        if (key == "surface_step") {
+            if (!py::isinstance<py::float_>(item.second) && !py::isinstance<py::int_>(item.second))
+                throw py::type_error("grid.surface_step: must be a number");
+            grid.surface_step = item.second.cast<double>();
+            continue;
+        }
         int* field = key == "radii"         ? &grid.radii
                      : key == "polar"       ? &grid.polar
                      : key == "zenith"      ? &grid.zenith

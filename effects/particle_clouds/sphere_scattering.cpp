@@ -31,30 +31,34 @@ double exit_distance(const Vec& p, const Vec& d) {
     return b > 0.0 ? -c / (b + root) : root - b;  // the larger root of t^2 + 2 b t + c, without cancellation
 }
 
-// Radial nodes graded toward the surface (eq. 2.7): depth u = 1 - r at index
-// x (0..1) is expm1(a x) / expm1(a), with a making the first step 0.25 / tau
-// optical depths when the uniform step would be coarser.
+// Radial nodes graded toward the surface (eq. 2.7): the depth u = 1 - r at
+// index x (0..1) is (c / a) log1p(k expm1(a x)), k = s (n - 1) / c. The steps
+// start at s = `surface_step` optical depths (when that is under 0.35 of the
+// uniform step), grow geometrically and level off at c times the uniform step.
 struct RadialMap {
+    static constexpr double kCap = 2.0;  // c: the largest step over the uniform one
     int n = 2;
-    double a = 0.0;  // 0: uniform
+    double a = 0.0, k = 0.0;  // a = 0: uniform
 
-    RadialMap(int nodes, double tau) : n(nodes) {
-        const double uniform = 1.0 / (n - 1), first = std::min(0.05 / tau, 0.35 * uniform);
+    RadialMap(int nodes, double tau, double surface_step) : n(nodes) {
+        const double uniform = 1.0 / (n - 1), first = std::min(surface_step / tau, 0.35 * uniform);
         if (first >= uniform) return;
-        double lo = 1e-9, hi = 400.0;  // expm1(a / (n - 1)) / expm1(a) falls with a
+        k = first * (n - 1) / kCap;
+        double lo = 1e-9, hi = 500.0;  // the depth at x = 1 rises with a, from first / uniform < 1 to kCap > 1
         for (int it = 0; it < 200; ++it) {
             const double mid = 0.5 * (lo + hi);
-            (std::expm1(mid * uniform) / std::expm1(mid) > first ? lo : hi) = mid;
+            (kCap / mid * std::log1p(k * std::expm1(mid)) < 1.0 ? lo : hi) = mid;
         }
         a = 0.5 * (lo + hi);
     }
     double radius(int i) const {
         const double x = double(i) / (n - 1);
-        return 1.0 - (a > 0.0 ? std::expm1(a * x) / std::expm1(a) : x);
+        if (i == n - 1) return 0.0;
+        return 1.0 - (a > 0.0 ? std::min(1.0, kCap / a * std::log1p(k * std::expm1(a * x))) : x);
     }
     double index(double r) const {  // fractional node index of radius r
         const double u = std::clamp(1.0 - r, 0.0, 1.0);
-        return (a > 0.0 ? std::log1p(u * std::expm1(a)) / a : u) * (n - 1);
+        return (a > 0.0 ? std::min(1.0, std::log1p(std::expm1(a * u / kCap) / k) / a) : u) * (n - 1);
     }
 };
 
@@ -105,6 +109,9 @@ void validate_sphere_grid(const SphereGrid& grid) {
     check("azimuth", grid.azimuth, 2, 256);
     check("march_steps", grid.march_steps, 1, 4096);
     check("orders", grid.orders, 1, 1000);
+    if (!(grid.surface_step >= 1e-3 && grid.surface_step <= 1.0))
+        throw std::invalid_argument("grid.surface_step: must be in [0.001, 1] mean free paths, got " +
+                                    std::to_string(grid.surface_step));
 }
 
 struct SphereScattering::Impl {
@@ -135,7 +142,7 @@ struct SphereScattering::Impl {
         : tau(tau_),
           g(g_),
           grid(grid_),
-          radial(grid_.radii, tau_),
+          radial(grid_.radii, tau_, grid_.surface_step),
           polar_nodes(grid_.polar, grid_.graded_polar ? tau_ : 0.0) {
         for (int j = 0; j < grid.polar; ++j) polar_angles.push_back(polar_nodes.angle(j));
         dirs = grid.zenith * grid.azimuth;

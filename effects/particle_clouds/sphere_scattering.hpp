@@ -35,12 +35,15 @@ private:
 // How finely the light field inside the sphere is resolved (physics.md
 // section 2.3; the defaults are chosen in effects/particle_clouds/docs/).
 struct SphereGrid {
-    int radii = 16;        // radial nodes, graded toward the surface in optical depth (eq. 2.7)
+    int radii = 24;        // radial nodes, graded toward the surface in optical depth (eq. 2.7)
     int polar = 32;        // the position's angle from the sun's axis, [0, pi], graded toward the terminator
     int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
     int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
     int march_steps = 16;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
     int orders = 18;       // scattering orders solved one by one (the source sums 18)
+    // The depth of the first radial node under the surface, in mean free paths, where the uniform
+    // step would be coarser (eq. 2.7); the radial steps grow from it and level off at twice the uniform step.
+    double surface_step = 0.05;
     // Also solve the sum of every order beyond `orders` at once (eq. 2.11): a thick particle's light
     // still inside after 18 orders is 19-60 % of what it scatters (effects/particle_clouds/physics.md
     // section 2.7). Off, the orders stop at `orders`, as in the source.

@@ -60,7 +60,9 @@ noise there), and g = 0.9 (the direction grid).
 Runtime with --spp 262144 (15 cases, 25 rays, five depths): 74 minutes on 2 cores shared with other
 benchmarks (solver 548 s, Mitsuba 3863 s: without roulette the thick spheres' paths run to thousands
 of scatterings); the last line of the text file. Mitsuba's time is
-proportional to --spp. --quick (tau 5, g 0.5, 65536 samples): about a minute.
+proportional to --spp. --quick (tau 5, g 0.5, 65536 samples): about a minute. --stored FILE compares
+with the values a --json run stored (the solver alone, about 10 minutes; no Mitsuba needed), and
+--grid '{"radii": 24}' changes the solver's grid: together they try a grid against the path tracer.
 """
 
 from __future__ import annotations
@@ -133,10 +135,11 @@ def sweep_rays() -> tuple[np.ndarray, np.ndarray, list[str]]:
     return np.concatenate(origins), np.concatenate(dirs), labels
 
 
-def solver_by_order(tau: float, g: float, origins: np.ndarray, dirs: np.ndarray, steps: int) -> np.ndarray:
+def solver_by_order(tau: float, g: float, origins: np.ndarray, dirs: np.ndarray, steps: int,
+                    grid_keys: dict | None = None) -> np.ndarray:
     """The solver's radiance (n_rays, ORDERS + 1): orders 1..ORDERS and every order beyond (eq. 2.11),
-    one call (the default grid)."""
-    grid = {"orders": ORDERS, "beyond": True}
+    one call (the default grid, with ``grid_keys`` in place of its fields)."""
+    grid = {**(grid_keys or {}), "orders": ORDERS, "beyond": True}
     return airlight._core.particle_sphere_radiance(tau, g, SUN, origins, dirs, grid, steps)
 
 
@@ -260,19 +263,38 @@ def main() -> None:
                     help="write Mitsuba's means and standard errors per case, column and ray (with the rays) "
                     "to this file: the stored reference of test_sphere_scattering's thick-sphere test")
     ap.add_argument("--quick", action="store_true", help="tau 5, g 0.5 only, 65536 samples")
+    ap.add_argument("--stored", default=None,
+                    help="compare with the Mitsuba values a --json run stored in this file instead of "
+                    "rendering them (the solver alone: minutes, no Mitsuba needed; its cases and rays)")
+    ap.add_argument("--grid", type=json.loads, default={},
+                    help='solver grid fields in place of the defaults, as JSON (e.g. \'{"radii": 24}\')')
     args = ap.parse_args()
     if args.quick:
         args.taus, args.gs, args.spp = [5.0], [0.5], 65536
+    if args.stored and args.json:
+        ap.error("--json stores what Mitsuba rendered; with --stored nothing is rendered")
 
     t_start = time.perf_counter()
-    mi = sm.load(args.threads, args.libllvm)
     origins, dirs, labels = sweep_rays()
+    if args.stored:
+        kept = json.loads(Path(args.stored).read_text())
+        if not np.allclose(kept["origins"], origins) or not np.allclose(kept["dirs"], dirs):
+            sys.exit(f"{args.stored}: its rays are not this script's sweep_rays()")
+        stored_cases = {(c["tau"], c["g"]): c for c in kept["cases"]}
+        missing = [(t, g) for t in args.taus for g in args.gs if (t, g) not in stored_cases]
+        if missing:
+            sys.exit(f"{args.stored}: no stored case for (tau, g) {missing}")
+        reference = (f"Mitsuba {kept['mitsuba']} volpath ({kept['variant']}; stored in {args.stored}, "
+                     f"{kept['spp']} samples per ray and max_depth in {kept['chunks']} batch means)")
+    else:
+        mi = sm.load(args.threads, args.libllvm)
+        reference = (f"Mitsuba {mi.__version__} volpath ({mi.variant()}, sphere radius {RADIUS:g} in its "
+                     f"world, {args.spp} samples per ray and max_depth in {args.chunks} batch means, common "
+                     "random numbers)")
+    grid_name = "default grid" + (f" with {json.dumps(args.grid)}" if args.grid else "")
     lines = [
-        f"Solver (airlight particle_sphere_radiance, default grid, {ORDERS} orders and every order beyond, "
-        f"{args.steps} samples "
-        f"per camera ray) against Mitsuba {mi.__version__} volpath ({mi.variant()}, sphere radius "
-        f"{RADIUS:g} in its world, {args.spp} samples per ray and max_depth in {args.chunks} batch means, "
-        "common random numbers)",
+        f"Solver (airlight particle_sphere_radiance, {grid_name}, {ORDERS} orders and every order beyond, "
+        f"{args.steps} samples per camera ray) against {reference}",
         f"sun {tuple(float(x) for x in SUN)}; {len(dirs)} rays per case: views (sun . v) "
         + ", ".join(f"{n} {c:+.2f}" for n, c, _ in VIEWS)
         + "; offsets (r, degrees from the sun's side) " + ", ".join(f"({r:g}, {a:g})" for r, a in OFFSETS),
@@ -293,13 +315,16 @@ def main() -> None:
     stored: list[dict] = []
     for i_case, (tau, g) in enumerate((t, g) for t in args.taus for g in args.gs):
         t = time.perf_counter()
-        mine_k = solver_by_order(tau, g, origins, dirs, args.steps)
+        mine_k = solver_by_order(tau, g, origins, dirs, args.steps, args.grid)
         t_solver += time.perf_counter() - t
         mine = np.concatenate([mine_k[:, :3], mine_k[:, :ORDERS].sum(axis=1, keepdims=True),
                                mine_k.sum(axis=1, keepdims=True)], axis=1)
         seed = args.seed + 1000 * i_case
-        ref, se, sec = mitsuba_columns(tau, g, origins, dirs, args.spp, seed, args.chunks)
-        t_mitsuba += sec
+        if args.stored:
+            ref, se = (np.array(stored_cases[(tau, g)][k]) for k in ("mean", "se"))
+        else:
+            ref, se, sec = mitsuba_columns(tau, g, origins, dirs, args.spp, seed, args.chunks)
+            t_mitsuba += sec
         cases.append(f"tau {tau:g} g {g:g}")
         stored.append({"tau": tau, "g": g, "mean": ref.tolist(), "se": se.tolist()})
         for c, name in enumerate(COLUMNS):
@@ -320,8 +345,9 @@ def main() -> None:
             case = f"tau {tau:g} g {g:g} {name:>6}"
             failures += failing_rays(case, labels, st, mine[:, c], ref[:, c], se[:, c], "Mitsuba")
     total = time.perf_counter() - t_start
+    mitsuba_time = "stored" if args.stored else f"{t_mitsuba:.0f} s"
     finish(lines, ["over all cases: " + ", ".join(f"{c} {f}/{n} rays fail" for c, (n, f) in totals.items())],
-           failures, f"timing: solver {t_solver:.0f} s, Mitsuba {t_mitsuba:.0f} s, total {total:.0f} s "
+           failures, f"timing: solver {t_solver:.0f} s, Mitsuba {mitsuba_time}, total {total:.0f} s "
            f"({total / 60:.1f} min, {args.threads} threads)", args.out)
     if args.json:
         Path(args.json).parent.mkdir(parents=True, exist_ok=True)

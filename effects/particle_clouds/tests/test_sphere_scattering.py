@@ -158,19 +158,21 @@ def test_light_entering_where_the_sun_grazes_matches_the_path_tracer(tau: float,
     traced, stderr = sphere_paths.radiance_by_order(tau, g, SUN, origins, dirs, orders=orders, paths=1 << 17,
                                                     seed=7)
     np.testing.assert_array_less(np.abs(mine - traced), 0.03 * traced + 4.0 * stderr)
-    uniform = solve(tau, g, SUN, origins, dirs, {"orders": orders, "graded_polar": False}, 1024)
-    assert (np.abs(uniform - traced) > 0.03 * traced + 4.0 * stderr).any()  # what the grading fixes
+    if tau >= 50.0:  # what the grading fixes (at tau = 20, 2 mean free paths apart, uniform nodes pass)
+        uniform = solve(tau, g, SUN, origins, dirs, {"orders": orders, "graded_polar": False}, 1024)
+        assert (np.abs(uniform - traced) > 0.03 * traced + 4.0 * stderr).any()
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("tau", "g"), [(20.0, 0.0), (20.0, 0.5)])
+@pytest.mark.parametrize(("tau", "g"), [(20.0, 0.0), (20.0, 0.5), (50.0, 0.0)])
 def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float, g: float) -> None:
     # Every order, lit side to the sun's shadow, against Mitsuba 3 at unlimited depth without Russian
     # roulette (stored by bench/sphere_against_mitsuba.py --json with its standard errors): 2 % or 4
-    # standard errors on rays above 1e-3 of the brightest (all 50 are within the sweep's 3; the
-    # largest, -7.2 % at z = -2.7, on the shadowed limb). The shadowed side is where linear
-    # interpolation between nodes diffused light (physics.md section 2.3: 22 of these 25 rays at g = 0
-    # failed, by up to 2.4x).
+    # standard errors on rays above 1e-3 of the brightest (74 of these 75 are within the sweep's 3; the
+    # other, tau = 50's side-lit centre at +2.6 %, z = 3.3, is mostly Mitsuba's low order 1 there,
+    # physics.md 2.6). The shadowed side is where linear interpolation between nodes diffused light
+    # (section 2.3: 22 of the 25 rays of tau = 20, g = 0 failed, by up to 2.4x) and where coarse radial
+    # steps near a tau = 50 particle's centre darkened the deepest shadow by 12-24 % (eq. 2.7).
     ref = json.loads((Path(__file__).resolve().parent / "sphere_mitsuba_reference.json").read_text())
     case = next(c for c in ref["cases"] if c["tau"] == tau and c["g"] == g)
     total = ref["columns"].index("total")
@@ -183,7 +185,9 @@ def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float
 
 
 @pytest.mark.parametrize(("grid", "field"), [({"radii": 1}, "grid.radii"), ({"zenith": 0}, "grid.zenith"),
-                                             ({"orders": 0}, "grid.orders"), ({"stepz": 3}, "grid.stepz")])
+                                             ({"orders": 0}, "grid.orders"), ({"stepz": 3}, "grid.stepz"),
+                                             ({"surface_step": 0.0}, "grid.surface_step"),
+                                             ({"surface_step": float("nan")}, "grid.surface_step")])
 def test_a_bad_grid_is_a_clear_error(grid: dict, field: str) -> None:
     origins, dirs = orthographic_rays([1.0, 0.0, 0.0], [(0.0, 0.0)])
     with pytest.raises(ValueError, match=field):
@@ -195,6 +199,12 @@ def test_a_switch_that_is_not_a_bool_is_a_clear_error(key: str) -> None:
     origins, dirs = orthographic_rays([1.0, 0.0, 0.0], [(0.0, 0.0)])
     with pytest.raises(TypeError, match=f"grid.{key}"):
         solve(1.0, 0.5, SUN, origins, dirs, {key: "yes"}, 16)
+
+
+def test_a_surface_step_that_is_not_a_number_is_a_clear_error() -> None:
+    origins, dirs = orthographic_rays([1.0, 0.0, 0.0], [(0.0, 0.0)])
+    with pytest.raises(TypeError, match="grid.surface_step"):
+        solve(1.0, 0.5, SUN, origins, dirs, {"surface_step": "fine"}, 16)
 
 
 @pytest.mark.parametrize(("tau", "g", "field"), [(0.0, 0.5, "tau"), (1e4, 0.5, "tau"), (1.0, 1.0, "g"),
