@@ -33,18 +33,17 @@ double exit_distance(const Vec& p, const Vec& d) {
 
 // Radial nodes graded toward the surface (eq. 2.7): the depth u = 1 - r at
 // index x (0..1) is (c / a) log1p(k expm1(a x)), k = s (n - 1) / c. The steps
-// start at s = `surface_step` optical depths (when that is under 0.35 of the
-// uniform step), grow geometrically and level off at c times the uniform step.
+// start at s, `surface_step` optical depths or 0.35 of the uniform step where
+// that is smaller, grow geometrically and level off at c times the uniform step.
 struct RadialMap {
     static constexpr double kCap = 2.0;  // c: the largest step over the uniform one
     int n = 2;
-    double a = 0.0, k = 0.0;  // a = 0: uniform
+    double a = 0.0, k = 0.0;
 
     RadialMap(int nodes, double tau, double surface_step) : n(nodes) {
-        const double uniform = 1.0 / (n - 1), first = std::min(surface_step / tau, 0.35 * uniform);
-        if (first >= uniform) return;
+        const double first = std::min(surface_step / tau, 0.35 / (n - 1));
         k = first * (n - 1) / kCap;
-        double lo = 1e-9, hi = 500.0;  // the depth at x = 1 rises with a, from first / uniform < 1 to kCap > 1
+        double lo = 1e-9, hi = 500.0;  // the depth at x = 1 rises with a, from first (n - 1) < 1 to kCap > 1
         for (int it = 0; it < 200; ++it) {
             const double mid = 0.5 * (lo + hi);
             (kCap / mid * std::log1p(k * std::expm1(mid)) < 1.0 ? lo : hi) = mid;
@@ -52,13 +51,12 @@ struct RadialMap {
         a = 0.5 * (lo + hi);
     }
     double radius(int i) const {
-        const double x = double(i) / (n - 1);
-        if (i == n - 1) return 0.0;
-        return 1.0 - (a > 0.0 ? std::min(1.0, kCap / a * std::log1p(k * std::expm1(a * x))) : x);
+        if (i >= n - 1) return 0.0;
+        return 1.0 - std::min(1.0, kCap / a * std::log1p(k * std::expm1(a * double(i) / (n - 1))));
     }
     double index(double r) const {  // fractional node index of radius r
         const double u = std::clamp(1.0 - r, 0.0, 1.0);
-        return (a > 0.0 ? std::min(1.0, std::log1p(std::expm1(a * u / kCap) / k) / a) : u) * (n - 1);
+        return std::min(1.0, std::log1p(std::expm1(a * u / kCap) / k) / a) * (n - 1);
     }
 };
 
