@@ -4,15 +4,20 @@
    (effects/multiple_scattering/tests/data/night_reference.json) per case:
    the table method (airlight) against the brute force (the path tracer's own time per case);
 2. the table's build time per (g, albedo);
-3. the per-pixel cost the term adds, on both backends (the foggy street, 16 lamps).
+3. the per-pixel cost the term adds, on both backends (the foggy street, 16 lamps);
+4. (--parts exact) error against the exact solution for isotropic scattering
+   (effects/multiple_scattering/tests/point_source_exact.py, physics.md eqs. 11.7 to 11.9) over
+   albedo 0.5 to 0.999 and optical radius 0.1 to 60, where the path tracer is noise-limited.
 
     .venv/bin/python effects/multiple_scattering/bench/bench_lamp_ms.py [--skip-gl] [--width 320]
+    .venv/bin/python effects/multiple_scattering/bench/bench_lamp_ms.py --parts exact
 """
 
 from __future__ import annotations
 
 import argparse
 import copy
+import math
 import sys
 import time
 from pathlib import Path
@@ -23,6 +28,7 @@ import airlight
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
 import ms_cases  # noqa: E402
+import point_source_exact  # noqa: E402
 
 
 def with_ms(scene: dict, on: bool) -> dict:
@@ -61,6 +67,40 @@ def accuracy(renderer: airlight.Renderer) -> None:
                           1e-3 * c['views'][0]['radiance']).sum()) for c in cases.values() if c['tau'] < 20)
     print(f"tau 0.5 to 5: {inside} of {measurable} views within ({inside / measurable:.3f}); "
           f"all cases: {total}")
+    print()
+
+
+EXACT_ANGLES = (0.5, 1.0, 2.0, 5.0, 10.0, 20.0, 30.0, 45.0, 60.0, 90.0, 120.0, 150.0, 180.0)
+
+
+def exact_isotropic(renderer: airlight.Renderer) -> None:
+    print("## Error against the exact solution, isotropic scattering (13 angles, 0.5 to 180 degrees; green)")
+    print()
+    print("The glow (single scattering and the table) against the exact single plus multiple scattering; "
+          "max and median |relative error| over the angles, and the angle of the max.")
+    print()
+    print("| albedo | tau | max abs error | at angle | median abs error | multiple / total at 90 degrees |")
+    print("|---|---|---|---|---|---|")
+    for albedo in (0.5, 0.9, 0.99, 0.999):
+        for tau in (0.1, 0.5, 2.0, 5.0, 20.0, 40.0, 60.0):
+            errors, share = [], 0.0
+            for angle in EXACT_ANGLES:
+                scene = ms_cases.night_scene(tau, 0.0)
+                scene["medium"]["albedo"] = albedo
+                scene["camera"] = ms_cases.camera([0.0, 0.0, ms_cases.LAMP_DISTANCE],
+                                                  ms_cases.glow_direction(angle))
+                got = float(renderer.render(scene)[0, 0, 1])
+                gamma = math.radians(angle)
+                single = point_source_exact.single(tau, gamma, albedo)
+                multiple = point_source_exact.glow(tau, gamma, albedo)
+                scale = ms_cases.LAMP_INTENSITY * scene["medium"]["sigma_t"] ** 2
+                errors.append(got / (scale * (single + multiple)) - 1.0)
+                if angle == 90.0:
+                    share = multiple / (single + multiple)
+            dev = np.abs(errors)
+            worst = int(np.argmax(dev))
+            print(f"| {albedo} | {tau} | {100 * dev[worst]:.2f} % ({100 * errors[worst]:+.1f} %) | "
+                  f"{EXACT_ANGLES[worst]} | {100 * np.median(dev):.2f} % | {share:.3f} |", flush=True)
     print()
 
 
@@ -115,12 +155,19 @@ def main() -> None:
                                      formatter_class=argparse.RawDescriptionHelpFormatter)
     parser.add_argument("--skip-gl", action="store_true")
     parser.add_argument("--width", type=int, default=320)
+    parser.add_argument("--parts", nargs="+", choices=["accuracy", "exact", "build", "cost"],
+                        default=["accuracy", "build", "cost"])
     args = parser.parse_args()
     with airlight.Renderer("cpu") as r:
-        accuracy(r)
-    build_times()
-    backends = ["cpu"] if args.skip_gl or "gl" not in airlight.available_backends() else ["cpu", "gl"]
-    per_pixel_cost(backends, args.width)
+        if "accuracy" in args.parts:
+            accuracy(r)
+        if "exact" in args.parts:
+            exact_isotropic(r)
+    if "build" in args.parts:
+        build_times()
+    if "cost" in args.parts:
+        backends = ["cpu"] if args.skip_gl or "gl" not in airlight.available_backends() else ["cpu", "gl"]
+        per_pixel_cost(backends, args.width)
 
 
 if __name__ == "__main__":

@@ -13,6 +13,7 @@ from typing import Any
 
 import ms_cases
 import numpy as np
+import point_source_exact
 import pytest
 from hypothesis import HealthCheck, given, settings
 from hypothesis import strategies as st
@@ -21,7 +22,9 @@ import airlight
 
 NIGHT = ms_cases.load_cases("night")["cases"]
 NOISE_LIMITED = {name for name in NIGHT if NIGHT[name]["tau"] == 20.0}
-NOISE_REASON = "reference noise-limited at tau = 20 (effects/multiple_scattering/docs/reference.md section 5)"
+NOISE_REASON = ("reference noise-limited at tau = 20 (effects/multiple_scattering/docs/reference.md "
+                "section 5; its isotropic case is -89 to +261 % off the exact solution, which the table "
+                "matches within 1.1 %)")
 # The views of a case that the issue's criterion covers: the glow down to 1e-3 of its peak (0.5 degree).
 PEAK_FRACTION = 1e-3
 
@@ -236,3 +239,72 @@ def test_a_camera_inside_a_lamp_far_from_the_origin_sees_the_same_glow_on_gl_and
     gl = renderer_cache("gl").render(scene)[0, 0, :3]
     np.testing.assert_allclose(gl, cpu, rtol=1e-2)
     assert np.all(np.isfinite(cpu)) and np.all(cpu > 0.0)
+
+
+# ----------------------------------------------------------------------------------------------
+# The exact solution for isotropic scattering (physics.md section 11, eqs. 11.7 to 11.9;
+# point_source_exact.py): an outside reference at every optical distance, where the path tracer is
+# noise-limited too.
+
+@pytest.mark.parametrize("albedo", [0.5, 0.9, 0.99])
+@pytest.mark.parametrize("r", [0.05, 0.5, 1.0, 3.0])
+def test_exact_isotropic_fluence_contour_form_equals_its_fourier_integral(albedo, r):
+    """Eq. 11.8 (pole and branch cut) against the plain oscillatory inverse transform of eq. 11.7."""
+    assert point_source_exact.collided_fluence(r, albedo) == pytest.approx(
+        point_source_exact.collided_fluence_fourier(r, albedo), rel=1e-8)
+
+
+@pytest.mark.parametrize("albedo", [0.5, 0.9, 0.99])
+def test_exact_isotropic_fluence_holds_every_scattering(albedo):
+    """The scattered fluence integrated over space is the transform at k = 0, a / (1 - a): the mean
+    path length of the light after its first scattering (per unit of the lamp's power)."""
+    r_max = 400.0 if albedo < 0.99 else 3000.0  # where e^{-kappa_0 r} is below 1e-30
+    assert point_source_exact.scattered_power(albedo, r_max) == pytest.approx(albedo / (1.0 - albedo),
+                                                                              rel=1e-9)
+
+
+def exact_glow_error(renderer: airlight.Renderer, tau: float, albedo: float,
+                     angles: list[float]) -> np.ndarray:
+    """The rendered glow (green; single scattering and the table) of a lamp in isotropic fog of optical
+    radius tau, relative to the exact single (point_source_exact.single) plus multiple scattering, at
+    the night reference's geometry."""
+    errors = []
+    for angle in angles:
+        scene = ms_cases.night_scene(tau, 0.0)
+        scene["medium"]["albedo"] = albedo
+        scene["camera"] = ms_cases.camera([0.0, 0.0, ms_cases.LAMP_DISTANCE], ms_cases.glow_direction(angle))
+        got = float(renderer.render(scene)[0, 0, 1])
+        gamma = math.radians(angle)
+        optical = point_source_exact.single(tau, gamma, albedo) + point_source_exact.glow(tau, gamma, albedo)
+        errors.append(got / (ms_cases.LAMP_INTENSITY * scene["medium"]["sigma_t"] ** 2 * optical) - 1.0)
+    return np.array(errors)
+
+
+@pytest.mark.parametrize("tau", sorted({case["tau"] for case in NIGHT.values()}))
+def test_isotropic_fog_glow_matches_the_exact_solution(cpu, tau):
+    """The night reference's isotropic cases (albedo 0.9, tau 0.5 to 20, all 16 angles from 0.5 to 180
+    degrees) against the exact solution: within 2 % (measured: 1.1 % at most, at tau 20 looking away;
+    effects/multiple_scattering/docs/lamps.md section 3). This covers tau 20, where Mitsuba is
+    noise-limited."""
+    errors = exact_glow_error(cpu, tau, ms_cases.NIGHT_ALBEDO, ms_cases.GLOW_ANGLES)
+    assert np.all(np.abs(errors) < 0.02), errors
+
+
+# Where the table's photons do not reach (physics.md section 12: they are followed to
+# R_kill = min(80, 5 + 25 L_d), and are too few far beyond a few diffusion lengths).
+FAR_FIELD_SHORT = {(0.5, 20.0), (0.5, 40.0), (0.9, 40.0)}
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("albedo", [0.5, 0.9, 0.99, 0.999])
+@pytest.mark.parametrize("tau", [0.1, 0.5, 2.0, 5.0, 20.0, 40.0])
+def test_isotropic_glow_matches_the_exact_solution_over_albedo_and_distance(cpu, albedo, tau, request):
+    """Albedo 0.5 to 0.999 and tau 0.1 to 40, 13 angles: the glow within 3 % of the exact solution
+    (measured 2 % at most). The far field of the less scattering fogs is a known failure
+    (FAR_FIELD_SHORT: 26 to 77 % dark at albedo 0.5, tau 20; effects/multiple_scattering/docs/lamps.md
+    section 3), marked as a strict expected failure so that a fix shows."""
+    if (albedo, tau) in FAR_FIELD_SHORT:
+        request.applymarker(pytest.mark.xfail(strict=True, reason="the table's photons do not reach "
+                                              "this far (physics.md section 12)"))
+    errors = exact_glow_error(cpu, tau, albedo, [0.5, 1, 2, 5, 10, 20, 30, 45, 60, 90, 120, 150, 180])
+    assert np.all(np.abs(errors) < 0.03), errors
