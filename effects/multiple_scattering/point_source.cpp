@@ -6,11 +6,11 @@
 #include <algorithm>
 #include <chrono>
 #include <cmath>
-#include <cstdio>
 #include <limits>
 #include <string>
 
 #include "numerics.hpp"
+#include "plane_parallel.hpp"
 #include "shader_cpp.hpp"
 
 namespace airlight {
@@ -96,9 +96,19 @@ constexpr double kCoreRadius = 0.02;   // optical: the pooled core, J = f / R (s
 constexpr double kSwitchRadius = 1.0;  // log bins below, linear above
 constexpr double kLinearBin = 0.2;
 constexpr double kWeightFloor = 1.0e-3;
-constexpr double kSurvival = 0.1;    // Russian roulette below the weight floor
-constexpr int kBatchPhotons = 1024;  // a group of 8 batches between budget checks: an albedo-1 walk
-constexpr int kGroupBatches = 8;     // of ~3000 collisions per photon overshoots the budget little
+constexpr double kSurvival = 0.1;  // Russian roulette below the weight floor
+// The far field (eq. 11.10): a bin of width kLinearBin holds J while its scores' relative
+// standard error is below kFarNoise and it lies kFarBoundary diffusion lengths inside R_kill (the
+// photons killed there take away the light that would come back: a bias of about
+// e^{-2 kFarBoundary}); beyond it J follows the mode (eq. 11.11), its amplitude from the bins before.
+constexpr double kFarNoise = 0.02;
+constexpr double kFarBoundary = 2.6;
+constexpr int kFarFitBins = 15;
+constexpr double kFarFitLengths = 2.0;
+constexpr double kFarFitStart = 3.0;  // transport mean free paths 1 / (1 - a g)
+constexpr int kModeNodes = 64;        // Gauss-Legendre cosines per hemisphere for the mode's rate
+constexpr int kBatchPhotons = 1024;   // a group of 8 batches between budget checks: an albedo-1 walk
+constexpr int kGroupBatches = 8;      // of ~3000 collisions per photon overshoots the budget little
 
 int theta_bin(double cos_theta, int nt) {
     const double theta = std::acos(std::clamp(cos_theta, -1.0, 1.0));
@@ -143,7 +153,8 @@ std::vector<double> phase_matrix(const PointSourcePhase& phase, int nt) {
 // The scores of one batch: collision weights by (channel, R bin, theta bin);
 // the R bin nr is the core.
 struct BatchScores {
-    std::vector<double> h;  // [c][ir][it], ir in [0, nr]
+    std::vector<double> h;   // [c][ir][it], ir in [0, nr]
+    std::vector<double> h2;  // [c][ir]: the squared scores (the bins' noise, eq. 11.10)
     long photons = 0;
     double collisions = 0.0;
 };
@@ -200,6 +211,62 @@ double azimuthal_phase(const PointSourcePhase& phase, double cos_i, double cos_o
     return value;
 }
 
+double diffusion_mode_rate(const PointSourcePhase& phase, double albedo) {
+    if (!(albedo > 0.0)) return 1.0;
+    if (albedo >= 1.0) return 0.0;
+    // Cosines mu_i on (-1, 1) with weights w_i; K_ij = 4 pi pbar(mu_i, mu_j), rows normalised so
+    // that (1/2) sum_j K_ij w_j = 1 (the scattering conserves energy on the nodes, as eq. 11.2's P).
+    std::vector<double> half_nodes, half_weights;
+    gauss_legendre_unit(kModeNodes, half_nodes, half_weights);
+    const int n = 2 * kModeNodes;
+    std::vector<double> mu(static_cast<size_t>(n)), w(static_cast<size_t>(n));
+    for (int i = 0; i < kModeNodes; ++i) {
+        mu[size_t(kModeNodes - 1 - i)] = -half_nodes[size_t(i)];
+        mu[size_t(kModeNodes + i)] = half_nodes[size_t(i)];
+        w[size_t(kModeNodes - 1 - i)] = w[size_t(kModeNodes + i)] = half_weights[size_t(i)];
+    }
+    std::vector<double> kw(size_t(n) * size_t(n));  // (a / 2) K_ij w_j
+    for (int i = 0; i < n; ++i) {
+        double norm = 0.0;
+        for (int j = 0; j < n; ++j) {
+            const double v = 4.0 * kPi * azimuthal_phase(phase, mu[size_t(i)], mu[size_t(j)]) * w[size_t(j)];
+            kw[size_t(i) * size_t(n) + size_t(j)] = v;
+            norm += 0.5 * v;
+        }
+        for (int j = 0; j < n; ++j) kw[size_t(i) * size_t(n) + size_t(j)] *= 0.5 * albedo / norm;
+    }
+    // Whether the Perron root of B(kappa) = diag(1 / (1 - kappa mu_i)) (a / 2) K W exceeds 1, by
+    // power iteration from the last vector until the Collatz-Wielandt bounds min_i and max_i of
+    // (B v)_i / v_i lie on one side of 1 (the root only grows with kappa).
+    std::vector<double> v(static_cast<size_t>(n), 1.0), bv(static_cast<size_t>(n));
+    auto root_above_one = [&](double kappa) {
+        for (int iteration = 0; iteration < 2000; ++iteration) {
+            double lo = std::numeric_limits<double>::infinity(), hi = 0.0, sum = 0.0;
+            for (int i = 0; i < n; ++i) {
+                double x = 0.0;
+                for (int j = 0; j < n; ++j) x += kw[size_t(i) * size_t(n) + size_t(j)] * v[size_t(j)];
+                x /= 1.0 - kappa * mu[size_t(i)];
+                lo = std::min(lo, x / v[size_t(i)]);
+                hi = std::max(hi, x / v[size_t(i)]);
+                bv[size_t(i)] = x;
+                sum += x;
+            }
+            for (int i = 0; i < n; ++i) v[size_t(i)] = bv[size_t(i)] / sum;
+            if (lo > 1.0) return true;
+            if (hi < 1.0) return false;
+            if (hi - lo < 1e-13) return 0.5 * (lo + hi) > 1.0;
+        }
+        return false;
+    };
+    if (!root_above_one(1.0 - 1e-9)) return 1.0;  // the mode lies closer to 1 than the nodes resolve
+    double lo = 0.0, hi = 1.0 - 1e-9;
+    for (int step = 0; step < 60 && hi - lo > 1e-13; ++step) {
+        const double mid = 0.5 * (lo + hi);
+        (root_above_one(mid) ? hi : lo) = mid;
+    }
+    return 0.5 * (lo + hi);
+}
+
 PointSourceField point_source_field(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
                                     const PointSourceSettings& settings) {
     const auto start = std::chrono::steady_clock::now();
@@ -225,6 +292,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
 
     auto run_batch = [&](uint64_t batch, BatchScores& out) {
         out.h.assign(3 * plane, 0.0);
+        out.h2.assign(3 * size_t(nr + 1), 0.0);
         out.photons = 0;
         out.collisions = 0.0;
         Rng rng(settings.seed, batch);
@@ -249,7 +317,11 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
                     const double mu = (dir.x * pos.x + dir.y * pos.y + dir.z * pos.z) / r;
                     const int ir = r2 < r_core2 ? nr : std::min(int(f.bin_coordinate(r)), nr - 1);
                     const size_t cell = size_t(ir) * size_t(nt) + size_t(theta_bin(mu, nt));
-                    for (int c = 0; c < 3; ++c) out.h[size_t(c) * plane + cell] += w[c] * albedo[size_t(c)];
+                    for (int c = 0; c < 3; ++c) {
+                        const double score = w[c] * albedo[size_t(c)];
+                        out.h[size_t(c) * plane + cell] += score;
+                        out.h2[size_t(c) * size_t(nr + 1) + size_t(ir)] += score * score;
+                    }
                 }
                 for (int c = 0; c < 3; ++c) w[c] *= albedo[size_t(c)];
                 scattered = true;
@@ -267,7 +339,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
         }
     };
 
-    std::vector<double> h(3 * plane, 0.0);
+    std::vector<double> h(3 * plane, 0.0), h2(3 * size_t(nr + 1), 0.0);
     std::vector<BatchScores> group(kGroupBatches);
     uint64_t next_batch = 0;
     while (f.collisions < settings.collision_budget && f.photons < settings.max_photons) {
@@ -276,6 +348,7 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
         next_batch += kGroupBatches;
         for (const BatchScores& b : group) {  // in batch order: the sums do not depend on the schedule
             for (size_t i = 0; i < h.size(); ++i) h[i] += b.h[i];
+            for (size_t i = 0; i < h2.size(); ++i) h2[i] += b.h2[i];
             f.photons += b.photons;
             f.collisions += b.collisions;
         }
@@ -304,6 +377,47 @@ PointSourceField point_source_field(const PointSourcePhase& phase, const std::ar
             }
         }
     }
+    // The far field (eq. 11.10), per channel: the last bin that holds J, the mode's rate kappa_0
+    // (eq. 11.11), and J at r_far as the mean of the bins' J carried to r_far along the mode, over
+    // the kFarFitLengths diffusion lengths before it (at least kFarFitBins bins; none nearer the
+    // lamp than kFarFitStart transport mean free paths or r_far / 2, where the mode may not yet
+    // hold), weighted by the bins' inverse variances.
+    for (int c = 0; c < 3; ++c) {
+        f.r_far[size_t(c)] = f.r_kill;
+        f.far_profile[size_t(c)].assign(size_t(nt), 0.0);
+        const double a = albedo[size_t(c)];
+        const double ac = std::max(3.0 * (1.0 - a) * (1.0 - a * g_mean), 0.0);
+        if (!(ac > 0.0)) continue;
+        const double length = 1.0 / std::sqrt(ac);  // the channel's diffusion length
+        const double r_limit = f.r_kill - kFarBoundary * length;
+        std::vector<double> weight(size_t(nr), 0.0);
+        int end = f.n_log;
+        for (; end < nr; ++end) {
+            double sum = 0.0;
+            for (int j = 0; j < nt; ++j) sum += h[size_t(c) * plane + size_t(end) * size_t(nt) + size_t(j)];
+            const double noise = sum > 0.0 ? std::sqrt(h2[size_t(c) * size_t(nr + 1) + size_t(end)]) / sum : 1.0;
+            if (noise > kFarNoise || f.bin_edge(end + 1) > r_limit) break;
+            weight[size_t(end)] = 1.0 / std::max(noise * noise, 1e-12);
+        }
+        const double transport = 1.0 / (1.0 - a * g_mean);  // the transport mean free path
+        const int first = int(std::ceil(f.bin_coordinate(kFarFitStart * transport)));
+        const int span = std::max(kFarFitBins, int(std::lround(kFarFitLengths * length / f.dr)));
+        const int begin = std::max({end - span, first, int(std::ceil(f.bin_coordinate(0.5 * f.bin_edge(end))))});
+        if (end >= nr || end - begin < kFarFitBins) continue;  // J held to R_kill, or too few bins
+        const double kappa =
+            c > 0 && a == albedo[size_t(c - 1)] ? f.kappa[size_t(c - 1)] : diffusion_mode_rate(phase, a);
+        const double r_far = f.bin_edge(end);
+        double total = 0.0;
+        for (int i = begin; i < end; ++i) total += weight[size_t(i)];
+        for (int i = begin; i < end; ++i) {
+            const double r = 0.5 * (f.bin_edge(i) + f.bin_edge(i + 1));
+            const double carry = weight[size_t(i)] / total * r / r_far * std::exp(kappa * (r - r_far));
+            for (int j = 0; j < nt; ++j)
+                f.far_profile[size_t(c)][size_t(j)] += carry * f.source[size_t(c)][size_t(i) * size_t(nt) + size_t(j)];
+        }
+        f.r_far[size_t(c)] = r_far;
+        f.kappa[size_t(c)] = kappa;
+    }
     for (int c = 0; c < 3; ++c) {
         f.log_source[size_t(c)].resize(f.source[size_t(c)].size());
         for (size_t i = 0; i < f.source[size_t(c)].size(); ++i) {
@@ -323,12 +437,23 @@ double PointSourceField::bin_edge(int i) const {
     return i <= n_log ? r_core * std::exp(i * dlog_r) : r_switch + (i - n_log) * dr;
 }
 
+double PointSourceField::reach() const {
+    for (int c = 0; c < 3; ++c)
+        if (r_far[size_t(c)] < r_kill) return std::numeric_limits<double>::infinity();
+    return r_kill;
+}
+
 double PointSourceField::at(int c, double r, double cos_theta) const {
-    if (r >= r_kill) return 0.0;
     const double theta = std::acos(std::clamp(cos_theta, -1.0, 1.0));
     const double ft = std::clamp(std::sqrt(theta / kPi) * nt - 0.5, 0.0, double(nt - 1));
     const int j0 = std::min(int(ft), nt - 2);
     const double wt = ft - j0;
+    const double rf = r_far[size_t(c)];
+    if (r > rf && rf < r_kill) {  // the diffusion mode (eq. 11.10)
+        const std::vector<double>& p = far_profile[size_t(c)];
+        return (p[size_t(j0)] * (1.0 - wt) + p[size_t(j0 + 1)] * wt) * rf / r * std::exp(-kappa[size_t(c)] * (r - rf));
+    }
+    if (r >= r_kill) return 0.0;
     if (r < r_core) {
         const std::vector<double>& k = core[size_t(c)];
         return (k[size_t(j0)] * (1.0 - wt) + k[size_t(j0 + 1)] * wt) / r;
@@ -356,7 +481,7 @@ std::array<double, 3> point_source_radiance(const PointSourceField& field, doubl
     // cos theta = -tanh u (section 11); midpoint rule in u, steps du <= 0.04
     // (theta and log R change by less) and ds <= 0.15 (e^{-s} by 15 %: 0.1 % error).
     const double b = tau * std::cos(gamma), h = std::max(tau * std::sin(gamma), tau * 1e-9);
-    const double s_end = std::max(b, 0.0) + 60.0;
+    const double s_end = std::max(b, 0.0) + 60.0, reach = field.reach();
     std::array<double, 3> sum = {0.0, 0.0, 0.0};
     double u = std::asinh(-b / h);
     for (int step = 0; step < 200000; ++step) {
@@ -364,7 +489,7 @@ std::array<double, 3> point_source_radiance(const PointSourceField& field, doubl
         const double du = std::min(0.04, 0.15 / r_here);
         const double um = u + 0.5 * du;
         const double s = b + h * std::sinh(um), r = h * std::cosh(um);
-        if (s > s_end || (r > field.r_kill && s > b)) break;
+        if (s > s_end || (r > reach && s > b)) break;
         const double weight = std::exp(-s) * r * du, cos_theta = -std::tanh(um);
         for (int c = 0; c < 3; ++c) sum[size_t(c)] += weight * field.at(c, r, cos_theta);
         u += du;

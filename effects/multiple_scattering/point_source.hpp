@@ -58,12 +58,25 @@ struct PointSourceField {
     std::array<std::vector<double>, 3> source;      // [channel][ir * nt + it]
     std::array<std::vector<double>, 3> log_source;  // log J, -inf where J = 0
     std::array<std::vector<double>, 3> core;        // [channel][it]: f = R J inside R_core
+    // Beyond r_far[c] channel c's bins are too sparse (or too near R_kill) to hold J, and J
+    // continues as the diffusion mode, its amplitude from the bins before (section 11, eq. 11.10):
+    // J = far_profile(theta) (r_far / R) e^{-kappa (R - r_far)}. r_far = r_kill where no fit is made.
+    std::array<double, 3> r_far{};
+    std::array<double, 3> kappa{};
+    std::array<std::vector<double>, 3> far_profile;  // [channel][it]: J at r_far
     // The continuous bin coordinate of radius r >= r_core (bin i is [i, i + 1)) and bin i's inner edge.
     double bin_coordinate(double r) const;
     double bin_edge(int i) const;
     // J at distance R (optical) and cos theta, channel c (bilinear between bin centres).
     double at(int c, double r, double cos_theta) const;
+    // The distance beyond which J is 0 on every channel (infinite where a channel has a far field).
+    double reach() const;
 };
+
+// kappa_0 of the diffusion mode e^{-kappa_0 R} (section 11, eq. 11.11): the decay rate of the
+// slowest plane-wave solution of the transport equation in the homogeneous medium, 0 for albedo 1,
+// 1 for albedo 0 (and where kappa_0 is within 1e-9 of 1).
+double diffusion_mode_rate(const PointSourcePhase& phase, double albedo);
 
 PointSourceField point_source_field(const PointSourcePhase& phase, const std::array<double, 3>& albedo,
                                     const PointSourceSettings& settings = {});

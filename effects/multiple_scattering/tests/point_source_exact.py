@@ -97,6 +97,27 @@ def single(tau: float, gamma: float, albedo: float) -> float:
     return albedo / (4.0 * math.pi) * value
 
 
+def hemisphere_kernel(beta: float, gamma: float) -> float:
+    """int_0^{2 pi} max(cos beta cos gamma + sin beta sin gamma cos phi, 0) dphi (physics.md eq. 13.3):
+    the weight of light arriving gamma off the lamp's direction on a surface whose normal is beta off it."""
+    a, b = math.cos(beta) * math.cos(gamma), abs(math.sin(beta) * math.sin(gamma))
+    if b <= abs(a):
+        return 2.0 * math.pi * a if a > 0.0 else 0.0
+    phi0 = math.acos(-a / b)
+    return 2.0 * (a * phi0 + b * math.sin(phi0))
+
+
+def irradiance(tau: float, beta: float, albedo: float) -> float:
+    """The irradiance of the light scattered at least twice on a surface element at optical distance tau,
+    its normal beta off the lamp's direction: int_0^pi L(tau, gamma) sin gamma K(beta, gamma) dgamma
+    (physics.md section 13) with L of eq. 11.9 (adaptive quadrature; tens of seconds a value)."""
+    edge = math.pi / 2.0 + beta if beta < math.pi / 2.0 else None  # where K reaches 0 (beta < 90 deg)
+    value, _ = integrate.quad(lambda g: glow(tau, g, albedo) * math.sin(g) * hemisphere_kernel(beta, g),
+                              0.0, math.pi, epsabs=0.0, epsrel=1e-6, limit=200,
+                              points=None if edge is None or edge >= math.pi else [edge])
+    return value
+
+
 def scattered_power(albedo: float, r_max: float = 200.0) -> float:
     """int G_c 4 pi r^2 dr over the ball of radius r_max, by quadrature of eq. 11.8; with the whole
     space it is the transform at k = 0, albedo / (1 - albedo) (each photon's mean number of
@@ -106,5 +127,5 @@ def scattered_power(albedo: float, r_max: float = 200.0) -> float:
     return value
 
 
-__all__ = ["collided_fluence", "collided_fluence_fourier", "diffusion_pole", "glow", "scattered_power",
-           "single"]
+__all__ = ["collided_fluence", "collided_fluence_fourier", "diffusion_pole", "glow", "hemisphere_kernel",
+           "irradiance", "scattered_power", "single"]

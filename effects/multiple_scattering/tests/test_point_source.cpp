@@ -1,7 +1,8 @@
 // The point lamp's multiple-scattering builder (effects/multiple_scattering/point_source.cpp,
 // physics.md sections 10 to 12): the azimuthal phase mean against brute-force
 // quadrature and its normalisation, energy conservation of the Monte Carlo
-// source (every order >= 2 scattering of an infinite medium: 4 pi a^2 / (1 - a)),
+// source (every order >= 2 scattering of an infinite medium: 4 pi a^2 / (1 - a)), the far field's
+// decay rate and its seam with the bins,
 // results independent of the thread count, the seed noise of the table, and
 // its build time. Run with --analysis to print the timings and noise.
 #include <algorithm>
@@ -85,6 +86,53 @@ void check_energy() {
             if (g_print) std::printf("energy g %.2f a %.2f: %.5f want %.5f\n", g, a, got, want);
             CHECK_MSG(a == 0.0 ? got == 0.0 : std::abs(got / want - 1.0) < 0.01, std::to_string(got));
         }
+    }
+}
+
+// kappa_0 of the diffusion mode (eq. 11.11): for isotropic scattering the root of
+// a artanh(kappa) / kappa = 1 (eq. 11.8); 0 for albedo 1, 1 for albedo 0; smaller for a forward
+// phase; and the diffusion limit sqrt(3 (1 - a)(1 - a g)) as the albedo tends to 1.
+void check_diffusion_mode_rate() {
+    for (double a : {0.3, 0.5, 0.9, 0.99, 0.999}) {
+        double lo = 1e-12, hi = 1.0 - 1e-15;
+        for (int k = 0; k < 200; ++k) {
+            const double mid = 0.5 * (lo + hi);
+            (a * std::atanh(mid) / mid > 1.0 ? hi : lo) = mid;
+        }
+        const double got = diffusion_mode_rate(hg(0.0), a);
+        if (g_print) std::printf("kappa_0 isotropic a %.3f: %.12f exact %.12f\n", a, got, lo);
+        CHECK_MSG(std::abs(got - lo) < 1e-7, std::to_string(got) + " " + std::to_string(lo));
+    }
+    CHECK(diffusion_mode_rate(hg(0.5), 1.0) == 0.0 && diffusion_mode_rate(hg(0.5), 0.0) == 1.0);
+    double previous = 1.0;
+    for (double g : {0.0, 0.5, 0.9, 0.95}) {
+        const double k = diffusion_mode_rate(hg(g), 0.9);
+        CHECK_MSG(k < previous && k > 0.0, std::to_string(g));
+        previous = k;
+        const double a = 0.99999, diffusion = std::sqrt(3.0 * (1.0 - a) * (1.0 - a * g));
+        const double near_one = diffusion_mode_rate(hg(g), a);
+        CHECK_MSG(std::abs(near_one / diffusion - 1.0) < 0.02,
+                  std::to_string(near_one) + " " + std::to_string(diffusion));
+    }
+}
+
+// The far field (eq. 11.10) takes over from the bins without a jump: the scalar J (integrated over
+// directions) just inside and just beyond r_far agree within the bins' noise.
+void check_far_field_continues_the_bins() {
+    for (double a : {0.5, 0.9}) {
+        const PointSourceField f = point_source_field(hg(0.0), {a, a, a});
+        CHECK_MSG(f.r_far[0] < f.r_kill, std::to_string(a));
+        auto scalar = [&](double r) {
+            double sum = 0.0;
+            for (int j = 0; j < 400; ++j) sum += f.at(0, r, -1.0 + (j + 0.5) / 200.0) / 200.0;
+            return sum;
+        };
+        const double inside = scalar(f.r_far[0] - 0.3), beyond = scalar(f.r_far[0] + 0.3);
+        const double mode = std::exp(-0.6 * f.kappa[0]) * (f.r_far[0] - 0.3) / (f.r_far[0] + 0.3);
+        if (g_print)
+            std::printf("far field a %.2f: r_far %.2f, J beyond / inside %.4f, the mode %.4f\n", a, f.r_far[0],
+                        beyond / inside, mode);
+        CHECK_MSG(std::abs(beyond / inside / mode - 1.0) < 0.05, std::to_string(beyond / inside / mode));
     }
 }
 
@@ -253,6 +301,8 @@ int main(int argc, char** argv) {
     g_print = argc > 1 && std::strcmp(argv[1], "--analysis") == 0;
     check_azimuthal_phase();
     check_energy();
+    check_diffusion_mode_rate();
+    check_far_field_continues_the_bins();
     check_threads_do_not_matter();
     check_table_interpolation();
     check_hemisphere_kernel();
