@@ -5,9 +5,10 @@
    the table method (airlight) against the brute force (the path tracer's own time per case);
 2. the table's build time per (g, albedo);
 3. the per-pixel cost the term adds, on both backends (the foggy street, 16 lamps);
-4. (--parts exact) error against the exact solution for isotropic scattering
-   (effects/multiple_scattering/tests/point_source_exact.py, physics.md eqs. 11.7 to 11.9) over
-   albedo 0.5 to 0.999 and optical radius 0.1 to 60, where the path tracer is noise-limited.
+4. (--parts exact) the stored path-traced glows of the isotropic cases against the exact solution for
+   isotropic scattering (effects/multiple_scattering/tests/point_source_exact.py, physics.md eqs.
+   11.7 to 11.9), and the renderer's error against it over albedo 0.5 to 0.999 and optical radius
+   0.1 to 60, where the path tracer is noise-limited.
 
     .venv/bin/python effects/multiple_scattering/bench/bench_lamp_ms.py [--skip-gl] [--width 320]
     .venv/bin/python effects/multiple_scattering/bench/bench_lamp_ms.py --parts exact
@@ -104,6 +105,41 @@ def exact_isotropic(renderer: airlight.Renderer) -> None:
     print()
 
 
+def mitsuba_against_exact() -> None:
+    """The stored path-traced glows of the isotropic cases against the exact solution: how often the
+    reference itself misses the criterion, and by how many of its standard errors."""
+    cases = ms_cases.load_cases("night")["cases"]
+    print("## The stored Mitsuba glows of the isotropic cases against the exact solution")
+    print()
+    print("| case | views | outside max(3 %, 3 se) of the exact value | "
+          "z = (Mitsuba - exact) / se: min, max | deviation: min, max |")
+    print("|---|---|---|---|---|")
+    outside_thin, views_thin = 0, 0
+    for name, case in sorted(cases.items(), key=lambda kv: kv[1]["tau"]):
+        if case["g"] != 0.0:
+            continue
+        tau, albedo = case["tau"], case["albedo"]
+        scale = case["scene"]["lights"][0]["intensity"] * case["scene"]["medium"]["sigma_t"] ** 2
+        ref = np.array([v["radiance"] for v in case["views"]])
+        err = np.array([v["stderr"] for v in case["views"]])
+        exact = np.array([scale * (point_source_exact.single(tau, math.radians(v["angle_deg"]), albedo) +
+                                   point_source_exact.glow(tau, math.radians(v["angle_deg"]), albedo))
+                          for v in case["views"]])
+        keep = ref >= 1e-3 * ref[0]
+        out = (np.abs(ref - exact) > ms_cases.allowed_deviation(exact, err))[keep]
+        z = ((ref - exact) / err)[keep]
+        dev = (ref / exact - 1.0)[keep]
+        if tau < 20:
+            outside_thin += int(out.sum())
+            views_thin += int(keep.sum())
+        print(f"| {name} | {int(keep.sum())} | {int(out.sum())} | {z.min():+.1f}, {z.max():+.1f} | "
+              f"{100 * dev.min():+.1f} %, {100 * dev.max():+.1f} % |")
+    print()
+    print(f"tau 0.5 to 5: the reference is outside on {outside_thin} of {views_thin} views "
+          f"({outside_thin / views_thin:.3f})")
+    print()
+
+
 def build_times() -> None:
     print("## Table build time per (g, albedo) (this process's first build of each)")
     print()
@@ -162,6 +198,7 @@ def main() -> None:
         if "accuracy" in args.parts:
             accuracy(r)
         if "exact" in args.parts:
+            mitsuba_against_exact()
             exact_isotropic(r)
     if "build" in args.parts:
         build_times()
