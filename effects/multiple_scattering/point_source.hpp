@@ -42,7 +42,7 @@ struct PointSourceSettings {
 // units (sigma_t = 1) for a lamp of unit intensity, per albedo channel: bins
 // over log R (R_core to R_switch), then R (to R_kill) and x = sqrt(theta / pi), theta the angle
 // between the light's propagation direction and the outward radial. Inside
-// R_core J = f(theta) / R (section 11).
+// R_core J = f(theta) / R (section 11); beyond r_far the diffusion mode (eq. 11.10).
 struct PointSourceField {
     int nr = 0;
     int nt = 0;
@@ -60,7 +60,8 @@ struct PointSourceField {
     std::array<std::vector<double>, 3> core;        // [channel][it]: f = R J inside R_core
     // Beyond r_far[c] channel c's bins are too sparse (or too near R_kill) to hold J, and J
     // continues as the diffusion mode, its amplitude from the bins before (section 11, eq. 11.10):
-    // J = far_profile(theta) (r_far / R) e^{-kappa (R - r_far)}. r_far = r_kill where no fit is made.
+    // J = far_profile(theta) (r_far / R) e^{-kappa (R - r_far)}, kappa the mode's rate kappa_0
+    // (eq. 11.11). r_far = r_kill where the bins hold J to R_kill (albedo 1, or too few bins).
     std::array<double, 3> r_far{};
     std::array<double, 3> kappa{};
     std::array<std::vector<double>, 3> far_profile;  // [channel][it]: J at r_far
