@@ -6,7 +6,7 @@
 set(EFFECT_SOURCES plane_parallel.cpp ms_tables.cpp ms_keys.cpp)
 set(EFFECT_SCENE_HEADER ms_scene.hpp)
 set(EFFECT_QUALITY MultipleScatteringQuality)
-set(EFFECT_QUALITY_KEYS multiple_scattering)
+set(EFFECT_QUALITY_KEYS multiple_scattering fading_rain_steps)
 set(EFFECT_FEATURES
     multiple_scattering=HAS_MULTIPLE_SCATTERING)  # the daytime atmosphere's multiple scattering
 set(EFFECT_TABLES

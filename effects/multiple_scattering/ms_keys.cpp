@@ -1,4 +1,4 @@
-// The quality key "multiple_scattering" (EFFECT_QUALITY_KEYS; README "Scene format").
+// The quality keys "multiple_scattering" and "fading_rain_steps" (EFFECT_QUALITY_KEYS; README "Scene format").
 #include "scene_keys.hpp"
 
 namespace airlight {
@@ -12,10 +12,12 @@ void preset_multiple_scattering_quality(QualityPreset, Scene&) {}
 
 void parse_multiple_scattering_quality(const SceneObject& quality, Scene& s) {
     if (auto v = quality.opt("multiple_scattering")) s.quality.multiple_scattering = read_bool(*v);
+    if (auto v = quality.opt("fading_rain_steps")) s.quality.fading_rain_steps = read_int(*v, 0, 16);
 }
 
 void write_multiple_scattering_quality(const Scene& s, json& quality) {
     quality["multiple_scattering"] = s.quality.multiple_scattering;
+    quality["fading_rain_steps"] = s.quality.fading_rain_steps;
 }
 
 }  // namespace airlight

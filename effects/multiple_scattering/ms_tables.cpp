@@ -8,6 +8,7 @@
 #include <chrono>
 #include <cmath>
 #include <cstring>
+#include <iterator>
 #include <string>
 
 #include "frame_data.hpp"
@@ -207,6 +208,91 @@ std::shared_ptr<const Table2D> multiple_scattering_table(const shader::SkyGpu& s
 
 namespace {
 
+// The species with the rain's extinction (grey, albedo 1: make_species_gpu) set
+// to exactly `extinction`, so that every frame's rung has the same key.
+void species_with_rain(const shader::SpeciesGpu species[shader::SPECIES_COUNT], double extinction,
+                       shader::SpeciesGpu out[shader::SPECIES_COUNT]) {
+    std::copy(species, species + shader::SPECIES_COUNT, out);
+    shader::SpeciesGpu& rain = out[shader::SPECIES_RAIN];
+    rain.sigma_t = rain.sigma_s = glm::vec4(glm::vec3(float(extinction)), 0.0f);
+}
+
+// The altitudes of a field table's levels (its last row).
+std::vector<float> table_altitudes(const Table2D& t) {
+    std::vector<float> y(size_t(t.width));
+    for (int k = 0; k < t.width; ++k) y[size_t(k)] = t.texels[(size_t(t.height - 1) * size_t(t.width) + size_t(k)) * 4];
+    return y;
+}
+
+// Row `row` of field table t at altitude y, linear between its levels as ms_row reads it (ms_field.glsl).
+glm::vec4 field_row_at(const Table2D& t, const std::vector<float>& levels, int row, float y) {
+    const size_t hi = size_t(std::upper_bound(levels.begin(), levels.end(), y) - levels.begin());
+    const size_t k0 = hi == 0 ? 0 : hi - 1, k1 = std::min(k0 + 1, levels.size() - 1);
+    const float a = k1 > k0 ? std::clamp((y - levels[k0]) / (levels[k1] - levels[k0]), 0.0f, 1.0f) : 0.0f;
+    const float* v0 = &t.texels[(size_t(row) * size_t(t.width) + k0) * 4];
+    const float* v1 = &t.texels[(size_t(row) * size_t(t.width) + k1) * 4];
+    return glm::mix(glm::vec4(v0[0], v0[1], v0[2], v0[3]), glm::vec4(v1[0], v1[1], v1[2], v1[3]), a);
+}
+
+// (1 - w) lo + w hi on the union of their levels (eq. 9.3). Each table is
+// piecewise linear in altitude, so it is reproduced exactly on the union: at
+// w = 0 or 1 the blend is the rung itself, whichever pair it belongs to.
+Table2D blend_field_tables(const Table2D& lo, const Table2D& hi, float w) {
+    const std::vector<float> y_lo = table_altitudes(lo), y_hi = table_altitudes(hi);
+    std::vector<float> y;
+    std::set_union(y_lo.begin(), y_lo.end(), y_hi.begin(), y_hi.end(), std::back_inserter(y));
+    y.erase(std::unique(y.begin(), y.end()), y.end());
+    Table2D t;
+    t.width = int(y.size());
+    t.height = lo.height;
+    t.channels = 4;
+    t.texels.resize(size_t(t.width) * size_t(t.height) * 4);
+    for (int row = 0; row + 1 < t.height; ++row)
+        for (int k = 0; k < t.width; ++k) {
+            const glm::vec4 v =
+                glm::mix(field_row_at(lo, y_lo, row, y[size_t(k)]), field_row_at(hi, y_hi, row, y[size_t(k)]), w);
+            std::memcpy(&t.texels[(size_t(row) * size_t(t.width) + size_t(k)) * 4], &v[0], sizeof(v));
+        }
+    for (int k = 0; k < t.width; ++k) t.texels[(size_t(t.height - 1) * size_t(t.width) + size_t(k)) * 4] = y[size_t(k)];
+    t.name = "ms_field_rain_blend";
+    return t;
+}
+
+}  // namespace
+
+std::shared_ptr<const Table2D> fading_rain_table(const shader::SkyGpu& sky,
+                                                 const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                                 const RgbD& ground, int segments, int steps) {
+    const shader::SpeciesGpu& rain = species[shader::SPECIES_RAIN];
+    const double extinction = double(rain.sigma_t.x);
+    const bool grey_rain = rain.phase.z != 0.0f && rain.sigma_t == rain.sigma_s && rain.sigma_t.x == rain.sigma_t.y &&
+                           rain.sigma_t.x == rain.sigma_t.z;
+    if (steps <= 0 || !grey_rain || !(extinction >= MS_RAIN_LADDER_FLOOR))
+        return multiple_scattering_table(sky, species, ground, segments);
+    // Eq. 9.3: rung k at MS_RAIN_LADDER_FLOOR 2^(k / steps); the scene's rain between k and k + 1.
+    const double x = steps * std::log2(extinction / MS_RAIN_LADDER_FLOOR);
+    const double k = std::floor(x);
+    const float w = float(x - k);
+    shader::SpeciesGpu lo[shader::SPECIES_COUNT], hi[shader::SPECIES_COUNT];
+    species_with_rain(species, MS_RAIN_LADDER_FLOOR * std::exp2(k / steps), lo);
+    species_with_rain(species, MS_RAIN_LADDER_FLOOR * std::exp2((k + 1.0) / steps), hi);
+    static TableCache<std::string> cache(4);  // the last 4 blends
+    std::string key = field_key(sky, species, ground, segments);
+    key.append(reinterpret_cast<const char*>(&steps), sizeof(steps));
+    std::shared_ptr<const Table2D> blended = cache.get(key, [&] {
+        const std::shared_ptr<const Table2D> table_lo = multiple_scattering_table(sky, lo, ground, segments);
+        const std::shared_ptr<const Table2D> table_hi = multiple_scattering_table(sky, hi, ground, segments);
+        const auto start = std::chrono::steady_clock::now();
+        Table2D t = blend_field_tables(*table_lo, *table_hi, w);
+        t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+        return t;
+    });
+    if (blended->width > shader::MS_MAX_LEVELS) return multiple_scattering_table(sky, species, ground, segments);
+    return blended;
+}
+
+namespace {
+
 // The ground's reflection alone (effects/multiple_scattering/physics.md
 // section 9): in an atmosphere too thin to scatter, the diffuse light is the
 // ground's Lambertian radiance rho E_0 / pi from below the horizon, so a
@@ -280,7 +366,8 @@ void pick_multiple_scattering_tables(const Scene& scene, FrameData& data) {
     if (!air && !bounce) return;
     std::shared_ptr<const Table2D> table;
     if (air) {
-        table = multiple_scattering_table(f.sky, f.species, ground, scene.quality.sky_segments);
+        table =
+            fading_rain_table(f.sky, f.species, ground, scene.quality.sky_segments, scene.quality.fading_rain_steps);
     } else {
         glm::dvec3 column(0.0);
         if (data.features.atmosphere) {

@@ -27,6 +27,10 @@ inline constexpr float MS_GROUND_BOUNCE_TOP = 1e9f;
 // A plane facing up within this distance (m) of y = 0 is the ground.
 inline constexpr float MS_GROUND_TOLERANCE = 1e-3f;
 
+// The fading rain's ladder (physics.md eq. 9.3): the rain extinction (1/m) of
+// its lowest rung. Rain thinner than this is solved exactly, per state.
+inline constexpr double MS_RAIN_LADDER_FLOOR = 1e-6;
+
 // True when the sky dome or the sun lights the atmosphere.
 bool sky_lights_atmosphere(const shader::SkyGpu& sky);
 
@@ -48,6 +52,17 @@ double clamped_cosine_mode(int m, double mu_n, double mu);
 std::shared_ptr<const Table2D> multiple_scattering_table(const shader::SkyGpu& sky,
                                                          const shader::SpeciesGpu species[shader::SPECIES_COUNT],
                                                          const RgbD& ground, int segments);
+
+// The table for a rain that may fade (quality.fading_rain_steps = steps > 0;
+// physics.md eq. 9.3): the fields solved at the two rain extinctions of the
+// ladder MS_RAIN_LADDER_FLOOR 2^(k / steps) around the scene's, each on its own
+// levels, blended linearly in log extinction on the union of their levels, so
+// that the frames of a fading rain share their solves and the blend is
+// continuous across rungs. Falls back to multiple_scattering_table where there
+// is no rain, rain thinner than the floor, or more levels than MS_MAX_LEVELS.
+std::shared_ptr<const Table2D> fading_rain_table(const shader::SkyGpu& sky,
+                                                 const shader::SpeciesGpu species[shader::SPECIES_COUNT],
+                                                 const RgbD& ground, int segments, int steps);
 
 // The ground's reflection alone, for an atmosphere too thin to scatter (or
 // none): E(y, n) = rho E_0 (1 - n_y) / 2, E_0 the unscattered irradiance on the
