@@ -30,8 +30,9 @@ fi
 # PythonicDISORT: an independent DISORT, the multiple-scattering solver's reference in tests.
 # OpenEXR (the official bindings): only the independent reader of tests/python/test_exr.py;
 # airlight itself writes and reads EXR through the C++ library (libopenexr-dev).
+# pytest-xdist: scripts/test.sh runs the tests in one worker per core.
 # ray, pyyaml, tqdm: the batch sweeps (airlight.batch; pyproject's "batch" extra); types-PyYAML for mypy.
-.venv/bin/python -m pip install -q numpy pillow pytest hypothesis scipy matplotlib colour-science \
+.venv/bin/python -m pip install -q numpy pillow pytest pytest-xdist hypothesis scipy matplotlib colour-science \
     "scikit-build-core>=0.10" "pybind11>=2.12" cmake ninja ruff mypy \
     PythonicDISORT "OpenEXR>=3.5,<4" "ray>=2.9" "pyyaml>=6" "tqdm>=4" types-PyYAML types-tqdm
 # --no-build-isolation: build with the tools just installed in .venv

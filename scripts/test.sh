@@ -3,6 +3,8 @@
 # Calls scripts/setup.sh first, so it also works on a fresh clone.
 #   bash scripts/test.sh           # the full suite (what CI runs)
 #   bash scripts/test.sh --quick   # the quick tier for development: the tests not marked slow
+# pytest runs one worker per core (pytest-xdist, -n auto): much of the suite is single-threaded
+# (Mesa's shader compiler, the numpy and scipy references), so two cores nearly halve it.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup.sh
@@ -14,7 +16,7 @@ ruff check python tests benchmarks examples effects tools conftest.py
 mypy python/airlight
 clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp effects/*/*.cpp effects/*/*.hpp effects/*/tests/*.cpp
 if [ "${1:-}" = "--quick" ]; then
-    python -m pytest -q --durations=15 -m "not slow"
+    python -m pytest -q -n auto --durations=15 -m "not slow"
 else
-    python -m pytest -q --durations=30
+    python -m pytest -q -n auto --durations=30
 fi

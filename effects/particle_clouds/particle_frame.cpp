@@ -2,6 +2,10 @@
 // lighting table for the droplets' g (built once per process, kept on disk),
 // the frame's particles and the screen tiles' lists, as tables both backends
 // read; nothing for a scene without particle clouds.
+#include <fcntl.h>
+#include <sys/file.h>
+#include <unistd.h>
+
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
@@ -45,19 +49,36 @@ Table2D build_light_table(float g, ParticleTableQuality quality) {
     std::snprintf(name, sizeof name, "particle_light_v%d_%s_g%.6f.bin", TABLE_FILE_VERSION,
                   quality == ParticleTableQuality::full ? "full" : "preview", double(g));
     const std::filesystem::path dir = cache_dir();
-    if (!dir.empty()) {
+    auto read_cached = [&] {
         std::ifstream in(dir / name, std::ios::binary);
         t.texels.resize(count);
-        if (in.read(reinterpret_cast<char*>(t.texels.data()), std::streamsize(count * sizeof(float))) &&
-            in.peek() == std::char_traits<char>::eof())
+        return in.read(reinterpret_cast<char*>(t.texels.data()), std::streamsize(count * sizeof(float))) &&
+               in.peek() == std::char_traits<char>::eof();
+    };
+    if (!dir.empty() && read_cached()) return t;
+    // One process builds, the others wait for its file: several renderers
+    // starting at once (a batch's workers, parallel tests) would otherwise each
+    // spend minutes on the same table. The lock goes with its process.
+    std::error_code ec;
+    int lock = -1;
+    if (!dir.empty()) {
+        std::filesystem::create_directories(dir, ec);
+        lock = ::open((dir / (std::string(name) + ".lock")).c_str(), O_RDWR | O_CREAT | O_CLOEXEC, 0644);
+        if (lock >= 0 && ::flock(lock, LOCK_EX) == 0 && read_cached()) {
+            ::close(lock);
             return t;
+        }
     }
+    struct CloseLock {
+        int fd;
+        ~CloseLock() {
+            if (fd >= 0) ::close(fd);
+        }
+    } close_lock{lock};
     const ParticleTable table(g, shape);
     t.texels = table.nodes();
     if (!dir.empty()) {
         // Written to a temporary name and renamed, so that a concurrent reader never sees half a file.
-        std::error_code ec;
-        std::filesystem::create_directories(dir, ec);
         const std::filesystem::path part = dir / (std::string(name) + ".part" + std::to_string(std::rand()));
         {
             std::ofstream out(part, std::ios::binary);
