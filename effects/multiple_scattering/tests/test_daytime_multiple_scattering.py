@@ -321,11 +321,14 @@ def test_no_nan_or_inf_over_weathers_suns_and_cameras(rain, visibility, aerosol_
     assert np.all(np.isfinite(image)) and np.all(image[..., :3] >= 0.0)
 
 
-@pytest.mark.parametrize("name", ["day_rain40_sun10", "day_fog100_overcast"])
-def test_gl_renders_multiple_scattering_as_the_cpu_does(renderer_cache, name: str) -> None:
+@pytest.mark.parametrize("name, fading_rain_steps", [("day_rain40_sun10", 0), ("day_fog100_overcast", 0),
+                                                     ("day_rain40_sun10", 4)])
+def test_gl_renders_multiple_scattering_as_the_cpu_does(renderer_cache, name: str,
+                                                        fading_rain_steps: int) -> None:
     gl = renderer_cache("gl")
     cpu = renderer_cache("cpu")
     scene = ms_cases.view_scene(DAY[name], 1)
+    scene["quality"] = {"fading_rain_steps": fading_rain_steps}
     scene["film"] = {"width": 24, "height": 16}
     scene["camera"]["fov_y"] = 100.0
     scene["surfaces"] += WALL
