@@ -29,41 +29,63 @@ BACKENDS = ("cpu", "gl")
 # point lamps in a medium rendered outside effects/multiple_scattering/ renders with it off unless the
 # scene sets it.
 MULTIPLE_SCATTERING_TESTS = ROOT / "effects" / "multiple_scattering"
+# Particle clouds rendered outside effects/particle_clouds/ (the preset sweeps) use the preview lighting
+# table unless the scene sets one: the full table is the same code at a finer resolution and costs
+# five minutes of both cores on a cold cache, that is on every CI machine; its accuracy is measured by
+# effects/particle_clouds/bench/table_resolution.py and the particle tests use the preview table too.
+PARTICLE_CLOUDS_TESTS = ROOT / "effects" / "particle_clouds"
+
+
+def _lamps_single_scattering(scene: dict) -> dict:
+    lights = scene.get("lights")
+    lamps = isinstance(lights, list) and any(isinstance(x, dict) and x.get("type", "point") == "point"
+                                             for x in lights)
+    if not (lamps and scene.get("medium")):  # only the lamps' term (the daytime tests set theirs)
+        return scene
+    quality = scene.get("quality")
+    if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
+        scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
+    return scene
+
+
+def _preview_particle_table(scene: dict) -> dict:
+    quality = scene.get("quality")
+    if scene.get("particle_clouds") and (quality is None or (isinstance(quality, dict)
+                                                             and "particle_table" not in quality)):
+        scene = {**scene, "quality": {**(quality or {}), "particle_table": "preview"}}
+    return scene
 
 
 @pytest.fixture(autouse=True)
-def single_scattering_unless_asked(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
-    if Path(str(request.fspath)).resolve().is_relative_to(MULTIPLE_SCATTERING_TESTS):
-        return
+def scene_defaults_for_tests(request: pytest.FixtureRequest, monkeypatch: pytest.MonkeyPatch) -> None:
+    """The two rules above, applied to every scene a test renders in this process."""
+    path = Path(str(request.fspath)).resolve()
+    rules = [rule for rule, home in ((_lamps_single_scattering, MULTIPLE_SCATTERING_TESTS),
+                                     (_preview_particle_table, PARTICLE_CLOUDS_TESTS))
+             if not path.is_relative_to(home)]
     from airlight import _rendering
 
     original = _rendering._with_film_size
 
-    def off(scene: Any) -> Any:
-        lights = scene.get("lights")
-        lamps = isinstance(lights, list) and any(isinstance(x, dict) and x.get("type", "point") == "point"
-                                                 for x in lights)
-        if not (lamps and scene.get("medium")):  # only the lamps' term (the daytime tests set theirs)
-            return scene
-        quality = scene.get("quality")
-        if quality is None or (isinstance(quality, dict) and "multiple_scattering" not in quality):
-            scene = {**scene, "quality": {**(quality or {}), "multiple_scattering": False}}
+    def adjust(scene: dict) -> dict:
+        for rule in rules:
+            scene = rule(scene)
         return scene
 
-    def single_scattering(scene: Any, width: Any, height: Any) -> Any:
-        source = original(off(scene) if isinstance(scene, dict) else scene, width, height)
+    def with_test_defaults(scene: Any, width: Any, height: Any) -> Any:
+        source = original(adjust(scene) if isinstance(scene, dict) else scene, width, height)
         if isinstance(source, dict):  # JSON text or a file with the film overridden
-            return off(source)
+            return adjust(source)
         if isinstance(source, str):  # JSON text or a file's text
             try:
                 data = json.loads(source)
             except (ValueError, RecursionError):
                 return source  # the validator names the error
             if isinstance(data, dict):
-                return json.dumps(off(data))
+                return json.dumps(adjust(data))
         return source
 
-    monkeypatch.setattr(_rendering, "_with_film_size", single_scattering)
+    monkeypatch.setattr(_rendering, "_with_film_size", with_test_defaults)
 
 
 def skip_unless_backend_available(backend: str) -> None:
