@@ -25,6 +25,7 @@
 #include "drop_optics.hpp"
 #include "drops.hpp"
 #include "frame_data.hpp"
+#include "ms_tables.hpp"
 #include "noise.hpp"
 #include "particle_field.hpp"
 #include "particle_table.hpp"
@@ -787,6 +788,7 @@ PYBIND11_MODULE(_core, m) {
         py::arg("n"), py::arg("p"), py::arg("bins"), py::arg("samples"));
     m.def("drop_order_energy", &airlight::drop_order_energy, py::arg("n"), py::arg("p"), py::arg("incidence"));
     m.attr("DROP_ORDERS") = airlight::DROP_ORDERS;
+    m.attr("MS_RAIN_LADDER_FLOOR") = airlight::MS_RAIN_LADDER_FLOOR;  // effects/multiple_scattering/ms_tables.hpp
     // Rainbow tables (effects/rainbow/rainbow.hpp): exposed for tests and benchmarks.
     m.def(
         "rainbow_phase_table",

@@ -217,10 +217,18 @@ void species_with_rain(const shader::SpeciesGpu species[shader::SPECIES_COUNT], 
     rain.sigma_t = rain.sigma_s = glm::vec4(glm::vec3(float(extinction)), 0.0f);
 }
 
-// The altitudes of a field table's levels (its last row).
+// The layout of a field table, from its size (with or without azimuths).
+FieldLayout layout_of(const Table2D& t) {
+    for (const bool azimuth : {false, true})
+        if (const FieldLayout l = field_layout(t.width, azimuth); l.rows == t.height) return l;
+    throw std::logic_error("ms field table: " + std::to_string(t.height) + " rows match no field layout");
+}
+
+// The altitudes of a field table's levels.
 std::vector<float> table_altitudes(const Table2D& t) {
+    const int row = layout_of(t).altitude_row;
     std::vector<float> y(size_t(t.width));
-    for (int k = 0; k < t.width; ++k) y[size_t(k)] = t.texels[(size_t(t.height - 1) * size_t(t.width) + size_t(k)) * 4];
+    for (int k = 0; k < t.width; ++k) y[size_t(k)] = t.texels[(size_t(row) * size_t(t.width) + size_t(k)) * 4];
     return y;
 }
 
@@ -234,26 +242,24 @@ glm::vec4 field_row_at(const Table2D& t, const std::vector<float>& levels, int r
     return glm::mix(glm::vec4(v0[0], v0[1], v0[2], v0[3]), glm::vec4(v1[0], v1[1], v1[2], v1[3]), a);
 }
 
-// (1 - w) lo + w hi on the union of their levels (eq. 9.3). Each table is
+// (1 - w) lo + w hi on y, the union of their levels (eq. 9.3). Each table is
 // piecewise linear in altitude, so it is reproduced exactly on the union: at
 // w = 0 or 1 the blend is the rung itself, whichever pair it belongs to.
-Table2D blend_field_tables(const Table2D& lo, const Table2D& hi, float w) {
+Table2D blend_field_tables(const Table2D& lo, const Table2D& hi, const std::vector<float>& y, float w) {
     const std::vector<float> y_lo = table_altitudes(lo), y_hi = table_altitudes(hi);
-    std::vector<float> y;
-    std::set_union(y_lo.begin(), y_lo.end(), y_hi.begin(), y_hi.end(), std::back_inserter(y));
-    y.erase(std::unique(y.begin(), y.end()), y.end());
     Table2D t;
     t.width = int(y.size());
     t.height = lo.height;
     t.channels = 4;
     t.texels.resize(size_t(t.width) * size_t(t.height) * 4);
-    for (int row = 0; row + 1 < t.height; ++row)
-        for (int k = 0; k < t.width; ++k) {
+    const int altitude_row = layout_of(lo).altitude_row;
+    for (int row = 0; row < t.height; ++row)
+        for (int k = 0; k < t.width && row != altitude_row; ++k) {
             const glm::vec4 v =
                 glm::mix(field_row_at(lo, y_lo, row, y[size_t(k)]), field_row_at(hi, y_hi, row, y[size_t(k)]), w);
             std::memcpy(&t.texels[(size_t(row) * size_t(t.width) + size_t(k)) * 4], &v[0], sizeof(v));
         }
-    for (int k = 0; k < t.width; ++k) t.texels[(size_t(t.height - 1) * size_t(t.width) + size_t(k)) * 4] = y[size_t(k)];
+    for (int k = 0; k < t.width; ++k) t.texels[(size_t(altitude_row) * size_t(t.width) + size_t(k)) * 4] = y[size_t(k)];
     t.name = "ms_field_rain_blend";
     return t;
 }
@@ -276,19 +282,22 @@ std::shared_ptr<const Table2D> fading_rain_table(const shader::SkyGpu& sky,
     shader::SpeciesGpu lo[shader::SPECIES_COUNT], hi[shader::SPECIES_COUNT];
     species_with_rain(species, MS_RAIN_LADDER_FLOOR * std::exp2(k / steps), lo);
     species_with_rain(species, MS_RAIN_LADDER_FLOOR * std::exp2((k + 1.0) / steps), hi);
+    const std::shared_ptr<const Table2D> table_lo = multiple_scattering_table(sky, lo, ground, segments);
+    const std::shared_ptr<const Table2D> table_hi = multiple_scattering_table(sky, hi, ground, segments);
+    const std::vector<float> y_lo = table_altitudes(*table_lo), y_hi = table_altitudes(*table_hi);
+    std::vector<float> y;
+    std::set_union(y_lo.begin(), y_lo.end(), y_hi.begin(), y_hi.end(), std::back_inserter(y));
+    y.erase(std::unique(y.begin(), y.end()), y.end());
+    if (y.size() > size_t(shader::MS_MAX_LEVELS)) return multiple_scattering_table(sky, species, ground, segments);
     static TableCache<std::string> cache(4);  // the last 4 blends
     std::string key = field_key(sky, species, ground, segments);
     key.append(reinterpret_cast<const char*>(&steps), sizeof(steps));
-    std::shared_ptr<const Table2D> blended = cache.get(key, [&] {
-        const std::shared_ptr<const Table2D> table_lo = multiple_scattering_table(sky, lo, ground, segments);
-        const std::shared_ptr<const Table2D> table_hi = multiple_scattering_table(sky, hi, ground, segments);
+    return cache.get(key, [&] {
         const auto start = std::chrono::steady_clock::now();
-        Table2D t = blend_field_tables(*table_lo, *table_hi, w);
+        Table2D t = blend_field_tables(*table_lo, *table_hi, y, w);
         t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
         return t;
     });
-    if (blended->width > shader::MS_MAX_LEVELS) return multiple_scattering_table(sky, species, ground, segments);
-    return blended;
 }
 
 namespace {
@@ -378,8 +387,7 @@ void pick_multiple_scattering_tables(const Scene& scene, FrameData& data) {
         table = ground_bounce_table(f.sky, f.species, ground, column);
     }
     data.features.multiple_scattering = true;
-    const bool azimuth = table->height > field_layout(table->width, false).rows;
-    const FieldLayout layout = field_layout(table->width, azimuth);
+    const FieldLayout layout = layout_of(*table);
     f.multiple_scattering.air_scattering = air ? 1.0f : 0.0f;
     f.multiple_scattering.level_count = float(layout.levels);
     f.multiple_scattering.view_azimuths = float(layout.view_azimuths);

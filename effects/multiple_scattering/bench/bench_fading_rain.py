@@ -40,7 +40,7 @@ import ms_cases  # noqa: E402
 from daytime_reference import rain_extinction  # noqa: E402
 
 SCALES = [2.0 ** (-j / 16) for j in range(16)]
-FLOOR = 1e-6  # MS_RAIN_LADDER_FLOOR (ms_tables.hpp)
+FLOOR = airlight._core.MS_RAIN_LADDER_FLOOR  # the ladder's lowest rung (ms_tables.hpp)
 
 
 def rain_cases() -> dict:

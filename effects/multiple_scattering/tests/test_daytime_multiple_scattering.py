@@ -260,7 +260,8 @@ def test_fading_rain_is_continuous_across_a_rung() -> None:
     case = DAY["day_rain40_sun10"]
     extinction = rain_extinction(case["scene"]["atmosphere"]["rain"]["rate"])
     steps = 4
-    rung = 1e-6 * 2.0 ** (np.ceil(steps * np.log2(extinction / 1e-6)) / steps)  # MS_RAIN_LADDER_FLOOR 2^(k/N)
+    floor = airlight._core.MS_RAIN_LADDER_FLOOR
+    rung = floor * 2.0 ** (np.ceil(steps * np.log2(extinction / floor)) / steps)  # eq. 9.3: floor 2^(k/N)
     for i in range(len(case["views"])):
         below = renderer.render(faded(case, i, rung / extinction * (1 - 1e-6), steps))[0, 0, :3]
         above = renderer.render(faded(case, i, rung / extinction * (1 + 1e-6), steps))[0, 0, :3]
@@ -274,7 +275,8 @@ def test_a_fading_rain_shares_its_solves() -> None:
     solved exactly."""
     case = DAY["day_rain40_overcast"]
     extinction = rain_extinction(case["scene"]["atmosphere"]["rain"]["rate"])
-    lower = 1e-6 * 2.0 ** (np.floor(4 * np.log2(extinction / 1e-6)) / 4)  # the rung below, of 4 per octave
+    floor = airlight._core.MS_RAIN_LADDER_FLOOR
+    lower = floor * 2.0 ** (np.floor(4 * np.log2(extinction / floor)) / 4)  # the rung below, of 4 per octave
     scales = [lower * 2.0 ** ((k + 0.5) / 32) / extinction for k in range(8)]  # between it and the next
     ladder = fresh_process_renders([faded(case, 0, s, 4) for s in scales])
     exact = fresh_process_renders([faded(case, 0, s, 0) for s in scales])
