@@ -108,8 +108,16 @@ std::string field_key(const shader::SkyGpu& sky, const shader::SpeciesGpu specie
     return key;
 }
 
+// The table of a solved field (ms_layout.glsl's rows).
+Table2D field_table(const MultipleScatteringField& field, const SlabAtmosphere& atm,
+                    const shader::SpeciesGpu species[shader::SPECIES_COUNT], const FieldLayout& layout);
+
+// The solve of one weather state and its table. With `by_source` the sun is
+// solved at unit irradiance in its own part (solve_plane_parallel_by_source):
+// the table holds the sky's part in its first layout.rows rows, the sun's in
+// the next (sunlit_table adds them, eq. 9.4).
 Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu species[shader::SPECIES_COUNT],
-                          const RgbD& ground, int segments) {
+                          const RgbD& ground, int segments, bool by_source) {
     const auto start = std::chrono::steady_clock::now();
     // Levels: the solver's (slab_levels), at most MS_MAX_LEVELS (thicker
     // layers where a very dense atmosphere needs more).
@@ -120,7 +128,8 @@ Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu sp
         levels = slab_levels(species, segments, depth);
     }
     const SlabAtmosphere atm = slab_from_species(species, levels);
-    const SlabIllumination light = slab_illumination(sky, ground);
+    SlabIllumination light = slab_illumination(sky, ground);
+    if (by_source) light.sun_irradiance = {1.0, 1.0, 1.0};
     const bool azimuth = sky.sun_direction.w != 0.0f || sky_has_azimuth(sky);
     const FieldLayout layout = field_layout(int(levels.size()), azimuth);
     SolverOptions options;
@@ -129,8 +138,23 @@ Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu sp
     for (int k = 0; k < shader::MS_VIEW_ELEVATIONS; ++k)
         options.view_mu.push_back(std::sin(-0.5 * kPi + kPi * k / (shader::MS_VIEW_ELEVATIONS - 1)));
     options.view_phi = uniform_nodes(0.0, kPi, layout.view_azimuths);
-    const MultipleScatteringField field = solve_plane_parallel(atm, light, options);
+    Table2D t;
+    if (by_source) {
+        const FieldBySource parts = solve_plane_parallel_by_source(atm, light, options);
+        t = field_table(parts.sky, atm, species, layout);
+        const Table2D sun = field_table(parts.sun, atm, species, layout);
+        t.height += sun.height;
+        t.texels.insert(t.texels.end(), sun.texels.begin(), sun.texels.end());
+    } else {
+        t = field_table(solve_plane_parallel(atm, light, options), atm, species, layout);
+    }
+    t.name = "ms_field";
+    t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    return t;
+}
 
+Table2D field_table(const MultipleScatteringField& field, const SlabAtmosphere& atm,
+                    const shader::SpeciesGpu species[shader::SPECIES_COUNT], const FieldLayout& layout) {
     Table2D t;
     t.width = layout.levels;
     t.height = layout.rows;
@@ -191,7 +215,33 @@ Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu sp
             texel(lev, layout.residual_row)[c] = float(field.sun_forward_irradiance[size_t(lev)][size_t(c)]);
         texel(lev, layout.altitude_row)[0] = float(field.altitudes[size_t(lev)]);
     }
-    t.name = "ms_field";
+    return t;
+}
+
+// The layout of a field table, from its size (with or without azimuths).
+FieldLayout layout_of(const Table2D& t) {
+    for (const bool azimuth : {false, true})
+        if (const FieldLayout l = field_layout(t.width, azimuth); l.rows == t.height) return l;
+    throw std::logic_error("ms field table: " + std::to_string(t.height) + " rows match no field layout");
+}
+
+// Eq. 9.4: the field under a sun of irradiance e (per channel), from a
+// by-source table: sky part + e x sun part at unit irradiance, row by row (the
+// altitudes as they are).
+Table2D sunlit_table(const Table2D& parts, const glm::vec3& e) {
+    const auto start = std::chrono::steady_clock::now();
+    Table2D t;
+    t.width = parts.width;
+    t.height = parts.height / 2;
+    t.channels = 4;
+    const size_t half = size_t(t.width) * size_t(t.height) * 4;
+    t.texels.assign(parts.texels.begin(), parts.texels.begin() + std::ptrdiff_t(half));
+    const int altitude_row = layout_of(t).altitude_row;
+    for (int row = 0; row < t.height; ++row)
+        for (size_t i = size_t(row) * size_t(t.width) * 4;
+             i < size_t(row + 1) * size_t(t.width) * 4 && row != altitude_row; i += 4)
+            for (int c = 0; c < 3; ++c) t.texels[i + size_t(c)] += e[c] * parts.texels[half + i + size_t(c)];
+    t.name = "ms_field_sunlit";
     t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return t;
 }
@@ -201,9 +251,20 @@ Table2D build_field_table(const shader::SkyGpu& sky, const shader::SpeciesGpu sp
 std::shared_ptr<const Table2D> multiple_scattering_table(const shader::SkyGpu& sky,
                                                          const shader::SpeciesGpu species[shader::SPECIES_COUNT],
                                                          const RgbD& ground, int segments) {
-    static TableCache<std::string> cache(4);  // the last 4 weather states
-    return cache.get(field_key(sky, species, ground, segments),
-                     [&] { return build_field_table(sky, species, ground, segments); });
+    static TableCache<std::string> solves(4);  // the last 4 weather states
+    if (sky.sun_direction.w == 0.0f)           // no sun: the sky's field alone
+        return solves.get(field_key(sky, species, ground, segments),
+                          [&] { return build_field_table(sky, species, ground, segments, false); });
+    // With a sun, one solve by source per state of everything but the sun's
+    // irradiance, so that a sun brightening or dimming re-uses it (eq. 9.4).
+    shader::SkyGpu unlit = sky;
+    unlit.sun_irradiance = glm::vec4(0.0f);
+    const std::shared_ptr<const Table2D> parts = solves.get(field_key(unlit, species, ground, segments), [&] {
+        return build_field_table(sky, species, ground, segments, true);
+    });
+    static TableCache<std::string> lit(4);
+    return lit.get(field_key(sky, species, ground, segments),
+                   [&] { return sunlit_table(*parts, glm::vec3(sky.sun_irradiance)); });
 }
 
 namespace {
@@ -215,13 +276,6 @@ void species_with_rain(const shader::SpeciesGpu species[shader::SPECIES_COUNT], 
     std::copy(species, species + shader::SPECIES_COUNT, out);
     shader::SpeciesGpu& rain = out[shader::SPECIES_RAIN];
     rain.sigma_t = rain.sigma_s = glm::vec4(glm::vec3(float(extinction)), 0.0f);
-}
-
-// The layout of a field table, from its size (with or without azimuths).
-FieldLayout layout_of(const Table2D& t) {
-    for (const bool azimuth : {false, true})
-        if (const FieldLayout l = field_layout(t.width, azimuth); l.rows == t.height) return l;
-    throw std::logic_error("ms field table: " + std::to_string(t.height) + " rows match no field layout");
 }
 
 // The altitudes of a field table's levels.

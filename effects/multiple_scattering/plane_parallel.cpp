@@ -346,8 +346,16 @@ double MultipleScatteringField::tilted_irradiance_nodes(int level, int channel, 
     return e;
 }
 
-MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const SlabIllumination& light,
-                                             const SolverOptions& opt) {
+namespace {
+
+// The solve (effects/multiple_scattering/physics.md sections 3-7). With `split`
+// the sky's light and the sun's travel in their own columns of the adding
+// method's source matrices (sky: 0 and 1, the cosine and sine of each azimuth
+// mode; sun: 2 and 3) and land in `sun_part`; otherwise both share columns 0
+// and 1 and everything lands in the returned field. The operators, the
+// costly part, are the same either way.
+MultipleScatteringField solve_sources(const SlabAtmosphere& atm, const SlabIllumination& light,
+                                      const SolverOptions& opt, MultipleScatteringField* sun_part) {
     const auto start = std::chrono::steady_clock::now();
     const int n = opt.streams;
     if (n < 2 || n > 128) throw std::invalid_argument("solve_plane_parallel: streams must be in [2, 128]");
@@ -359,6 +367,10 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     const bool sun = sun_mu > 0.0 &&
                      (light.sun_irradiance[0] > 0.0 || light.sun_irradiance[1] > 0.0 || light.sun_irradiance[2] > 0.0);
 
+    const bool split = sun_part != nullptr;
+    const int groups = split ? 2 : 1;  // column pairs: (sky and sun) or (sky), (sun)
+    const int cols = 2 * groups;
+    const int sun_col = split ? 2 : 0;
     MultipleScatteringField out;
     out.species_count = species;
     out.streams = n;
@@ -417,7 +429,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     // The sky's Fourier coefficients at the downward ordinates (look mu = mu_j).
     std::vector<std::array<Mat, 3>> sky(static_cast<size_t>(modes));
     for (int m = 0; m < modes; ++m)
-        for (int c = 0; c < 3; ++c) sky[size_t(m)][size_t(c)] = Mat::Zero(n, 2);
+        for (int c = 0; c < 3; ++c) sky[size_t(m)][size_t(c)] = Mat::Zero(n, cols);
     bool has_sky = bool(light.sky_radiance);
     if (has_sky) {
         const int ns = std::max(opt.sky_azimuth_samples, 2 * modes + 2);
@@ -450,6 +462,10 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     out.sky_direct_irradiance.assign(size_t(levels), RgbD{});
     out.sun_forward_irradiance.assign(size_t(levels), RgbD{});
     out.radiance_sh.assign(size_t(levels), {});
+    if (split) *sun_part = out;  // the same grids, its own zeroed outputs
+    // Where each column pair's outputs go, and the sun's own terms.
+    MultipleScatteringField* const target[2] = {&out, split ? sun_part : &out};
+    MultipleScatteringField& sun_out = *target[1];
 
     // The forward peak's residual beam (effects/multiple_scattering/physics.md section 6) and the unscattered light.
     for (int k = 0; k < levels; ++k)
@@ -458,8 +474,8 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             const double tt = depth_true[size_t(k)][size_t(c)], ts = depth_scaled[size_t(k)][size_t(c)];
             if (sun) {
                 const double e = light.sun_irradiance[size_t(c)];
-                out.sun_direct_irradiance[size_t(lev)][size_t(c)] = e * sun_mu * std::exp(-tt / sun_mu);
-                out.sun_forward_irradiance[size_t(lev)][size_t(c)] =
+                sun_out.sun_direct_irradiance[size_t(lev)][size_t(c)] = e * sun_mu * std::exp(-tt / sun_mu);
+                sun_out.sun_forward_irradiance[size_t(lev)][size_t(c)] =
                     e * std::exp(-ts / sun_mu) * -std::expm1(-(tt - ts) / sun_mu);
             }
             double sky_flux = 0.0;
@@ -469,16 +485,19 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             out.sky_direct_irradiance[size_t(lev)][size_t(c)] = sky_flux;
         }
     for (int c = 0; c < 3; ++c) {
-        double f = sun ? light.sun_irradiance[size_t(c)] * sun_mu : 0.0;
-        for (int j = 0; j < n; ++j) f += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * sky[0][size_t(c)](j, 0);
-        out.incident_flux[size_t(c)] = f;
+        sun_out.incident_flux[size_t(c)] = sun ? light.sun_irradiance[size_t(c)] * sun_mu : 0.0;
+        for (int j = 0; j < n; ++j)
+            out.incident_flux[size_t(c)] += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * sky[0][size_t(c)](j, 0);
     }
 
     // Per-species view kernels need Lambda at the view cosines (propagation u = -mu_view).
     std::vector<double> tmp;
-    double mode0_scale = 0.0;
-    int quiet_modes = 0;
-    int modes_solved = 0;
+    // Azimuth convergence per column pair, so that each part of a split solve
+    // is the solve of its source alone.
+    double mode0_scale[2] = {0.0, 0.0};
+    int quiet_modes[2] = {0, 0};
+    int modes_solved[2] = {0, 0};
+    bool converged[2] = {false, !split};
     const Mat id = Mat::Identity(n, n);
     for (int m = 0; m < modes; ++m) {
         ModeBasis basis;
@@ -516,9 +535,9 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
         // The channels are independent: one thread each when allowed, each
         // writing only its own channel's outputs.
         using Cache = std::vector<std::pair<const LayerOptics*, LayerOperators>>;
-        double channel_scale[3] = {0.0, 0.0, 0.0};
+        double channel_scale[3][2] = {};
         auto solve_channel = [&](int c, Cache& cache) {
-            double& mode_scale = channel_scale[c];
+            double* mode_scale = channel_scale[c];
             // Layer operators.
             std::vector<LayerOperators> ops(static_cast<size_t>(layers + 1));
             bool any_scatter = false;
@@ -558,7 +577,7 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             rb[0] = Mat::Zero(n, n);
             sdown[0] = sky[size_t(m)][size_t(c)];
             unsc[0] = sdown[0];
-            sd[0] = Mat::Zero(n, 2);
+            sd[0] = Mat::Zero(n, cols);
             for (int k = 0; k < layers; ++k) {
                 const LayerOperators& op = ops[size_t(k + 1)];
                 Mat t = op.diffuse_transmission;
@@ -567,16 +586,16 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 Mat src = sdown[size_t(k)];
                 Mat refl = op.reflection * sdown[size_t(k)];
                 if (sun) {
-                    src.col(0) += rb[size_t(k)] * op.sun_up * beta[size_t(k)];
-                    refl.col(0) += op.sun_up * beta[size_t(k)];
+                    src.col(sun_col) += rb[size_t(k)] * op.sun_up * beta[size_t(k)];
+                    refl.col(sun_col) += op.sun_up * beta[size_t(k)];
                 }
                 const Mat down = g.solve(src);
                 const Mat diffuse = sd[size_t(k)] + g.solve(rb[size_t(k)] * refl);
                 sdown[size_t(k + 1)] = t * down;
                 sd[size_t(k + 1)] = op.diffuse_transmission * down + op.direct.asDiagonal() * diffuse;
                 if (sun) {
-                    sdown[size_t(k + 1)].col(0) += op.sun_down * beta[size_t(k)];
-                    sd[size_t(k + 1)].col(0) += op.sun_down * beta[size_t(k)];
+                    sdown[size_t(k + 1)].col(sun_col) += op.sun_down * beta[size_t(k)];
+                    sd[size_t(k + 1)].col(sun_col) += op.sun_down * beta[size_t(k)];
                 }
                 unsc[size_t(k + 1)] = op.direct.asDiagonal() * unsc[size_t(k)];
                 rb[size_t(k + 1)] = op.reflection + t * g.solve(rb[size_t(k)] * t);
@@ -586,13 +605,13 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             // nothing from above.
             std::vector<Mat> ru(static_cast<size_t>(levels)), sup(static_cast<size_t>(levels));
             ru[size_t(layers)] = Mat::Zero(n, n);
-            sup[size_t(layers)] = Mat::Zero(n, 2);
+            sup[size_t(layers)] = Mat::Zero(n, cols);
             if (albedo > 0.0) {
                 // Lambert: I+ = A / pi x (2 pi sum_j w_j mu_j I-_j + mu0 beam) (effects/multiple_scattering/physics.md
                 // section 5.1).
                 for (int i = 0; i < n; ++i)
                     for (int j = 0; j < n; ++j) ru[size_t(layers)](i, j) = 2.0 * albedo * w[size_t(j)] * mu[size_t(j)];
-                if (sun) sup[size_t(layers)].col(0).setConstant(albedo / kPi * sun_mu * beta[size_t(layers)]);
+                if (sun) sup[size_t(layers)].col(sun_col).setConstant(albedo / kPi * sun_mu * beta[size_t(layers)]);
             }
             for (int k = layers; k >= 1; --k) {
                 const LayerOperators& op = ops[size_t(k)];
@@ -601,9 +620,9 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 Eigen::PartialPivLU<Mat> h(id - ru[size_t(k)] * op.reflection);
                 ru[size_t(k - 1)] = op.reflection + t * h.solve(ru[size_t(k)] * t);
                 Mat src = sup[size_t(k)];
-                if (sun) src.col(0) += ru[size_t(k)] * op.sun_down * beta[size_t(k - 1)];
+                if (sun) src.col(sun_col) += ru[size_t(k)] * op.sun_down * beta[size_t(k - 1)];
                 sup[size_t(k - 1)] = t * h.solve(src);
-                if (sun) sup[size_t(k - 1)].col(0) += op.sun_up * beta[size_t(k - 1)];
+                if (sun) sup[size_t(k - 1)].col(sun_col) += op.sun_up * beta[size_t(k - 1)];
             }
             // Interface fields (effects/multiple_scattering/physics.md section 5.4) and the outputs.
             for (int k = 0; k < levels; ++k) {
@@ -619,21 +638,29 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                     for (int j = 0; j < n; ++j)
                         diffuse_down.row(j) += sky[size_t(m)][size_t(c)].row(j) * std::exp(-ts / mu[size_t(j)]) *
                                                -std::expm1(-(tt - ts) / mu[size_t(j)]);
-                for (int j = 0; j < n; ++j)
-                    for (int s = 0; s < 2; ++s) {
-                        out.node_radiance[out.node_index(lev, c, m, j, s)] = diffuse_down(j, s);
-                        out.node_radiance[out.node_index(lev, c, m, n + j, s)] = up(j, s);
-                    }
-                mode_scale = std::max({mode_scale, diffuse_down.cwiseAbs().maxCoeff(), up.cwiseAbs().maxCoeff()});
+                for (int g = 0; g < groups; ++g) {
+                    if (converged[g]) continue;
+                    for (int j = 0; j < n; ++j)
+                        for (int s = 0; s < 2; ++s) {
+                            MultipleScatteringField& o = *target[g];
+                            o.node_radiance[o.node_index(lev, c, m, j, s)] = diffuse_down(j, 2 * g + s);
+                            o.node_radiance[o.node_index(lev, c, m, n + j, s)] = up(j, 2 * g + s);
+                        }
+                    mode_scale[g] = std::max({mode_scale[g], diffuse_down.middleCols(2 * g, 2).cwiseAbs().maxCoeff(),
+                                              up.middleCols(2 * g, 2).cwiseAbs().maxCoeff()});
+                }
                 if (m == 0) {
-                    double fd = 0.0, fu = 0.0;
-                    for (int j = 0; j < n; ++j) {
-                        fd += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * diffuse_down(j, 0);
-                        fu += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * up(j, 0);
+                    for (int g = 0; g < groups; ++g) {
+                        double fd = 0.0, fu = 0.0;
+                        for (int j = 0; j < n; ++j) {
+                            fd += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * diffuse_down(j, 2 * g);
+                            fu += 2.0 * kPi * w[size_t(j)] * mu[size_t(j)] * up(j, 2 * g);
+                        }
+                        target[g]->irradiance_down[size_t(lev)][size_t(c)] = fd;
+                        target[g]->irradiance_up[size_t(lev)][size_t(c)] = fu;
                     }
-                    out.irradiance_down[size_t(lev)][size_t(c)] =
-                        fd + sun_mu * out.sun_forward_irradiance[size_t(lev)][size_t(c)];
-                    out.irradiance_up[size_t(lev)][size_t(c)] = fu;
+                    sun_out.irradiance_down[size_t(lev)][size_t(c)] +=
+                        sun_mu * sun_out.sun_forward_irradiance[size_t(lev)][size_t(c)];
                 }
                 // K_i^m(u_a) = 1/2 sum_j w_j [p^m(u, mu_j) I+_j + p^m(u, -mu_j) I-_j]
                 // (effects/multiple_scattering/physics.md section 6).
@@ -641,11 +668,14 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 const Mat wd = Eigen::Map<const Vec>(w.data(), n).asDiagonal() * diffuse_down;
                 for (int i = 0; i < species; ++i) {
                     const Mat kv = 0.5 * (view_same[size_t(i)] * wu + view_opposite[size_t(i)] * wd);
-                    double* dst = &out.phased_radiance[out.phased_index(lev, i, c, 0, 0)];
-                    for (int a = 0; a < nv; ++a)
-                        for (int b = 0; b < np; ++b)
-                            dst[size_t(a) * size_t(np) + size_t(b)] +=
-                                kv(a, 0) * cos_m[size_t(b)] + kv(a, 1) * sin_m[size_t(b)];
+                    for (int g = 0; g < groups; ++g) {
+                        if (converged[g]) continue;
+                        double* dst = &target[g]->phased_radiance[out.phased_index(lev, i, c, 0, 0)];
+                        for (int a = 0; a < nv; ++a)
+                            for (int b = 0; b < np; ++b)
+                                dst[size_t(a) * size_t(np) + size_t(b)] +=
+                                    kv(a, 2 * g) * cos_m[size_t(b)] + kv(a, 2 * g + 1) * sin_m[size_t(b)];
+                    }
                 }
             }
         };
@@ -657,18 +687,23 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
             Cache cache;  // shared: grey channels reuse each other's layers
             for (int c = 0; c < 3; ++c) solve_channel(c, cache);
         }
-        const double mode_scale = std::max({channel_scale[0], channel_scale[1], channel_scale[2]});
-        modes_solved = m + 1;
         // Azimuth convergence (effects/multiple_scattering/physics.md section 3): two modes in a row below the
         // tolerance.
-        if (m == 0)
-            mode0_scale = mode_scale;
-        else {
-            quiet_modes = mode_scale <= opt.azimuth_tolerance * mode0_scale ? quiet_modes + 1 : 0;
-            if (quiet_modes >= 2) break;
+        for (int g = 0; g < groups; ++g) {
+            if (converged[g]) continue;
+            const double mode_scale = std::max({channel_scale[0][g], channel_scale[1][g], channel_scale[2][g]});
+            modes_solved[g] = m + 1;
+            if (m == 0)
+                mode0_scale[g] = mode_scale;
+            else {
+                quiet_modes[g] = mode_scale <= opt.azimuth_tolerance * mode0_scale[g] ? quiet_modes[g] + 1 : 0;
+                converged[g] = quiet_modes[g] >= 2;
+            }
         }
+        if (converged[0] && converged[1]) break;
     }
-    out.modes_solved = modes_solved;
+    out.modes_solved = modes_solved[0];
+    if (split) sun_part->modes_solved = modes_solved[1];
 
     // The sun's forward-peak residual scattered by each species' full phase (effects/multiple_scattering/physics.md
     // section 6).
@@ -685,9 +720,9 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
                 }
             for (int lev = 0; lev < levels; ++lev)
                 for (int c = 0; c < 3; ++c) {
-                    const double res = out.sun_forward_irradiance[size_t(lev)][size_t(c)];
+                    const double res = sun_out.sun_forward_irradiance[size_t(lev)][size_t(c)];
                     if (res == 0.0) continue;
-                    double* dst = &out.phased_radiance[out.phased_index(lev, i, c, 0, 0)];
+                    double* dst = &sun_out.phased_radiance[out.phased_index(lev, i, c, 0, 0)];
                     for (size_t k = 0; k < phase_sun.size(); ++k) dst[k] += phase_sun[k] * res;
                 }
         }
@@ -696,31 +731,48 @@ MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const Sl
     // Spherical harmonics l <= 2 of the diffuse radiance (effects/multiple_scattering/physics.md section 7): modes 0..2
     // are the only ones they see; 16 azimuths integrate them exactly.
     const int az = 16;
-    for (int lev = 0; lev < levels; ++lev)
-        for (int c = 0; c < 3; ++c) {
-            std::array<double, 9> sh{};
-            for (int node = 0; node < 2 * n; ++node) {
-                const int j = node % n;
-                const double mv = node < n ? mu[size_t(j)] : -mu[size_t(j)];
-                for (int s = 0; s < az; ++s) {
-                    const double phi = 2.0 * kPi * s / az;
-                    double l = 0.0;
-                    for (int m = 0; m < std::min(3, modes); ++m)
-                        l += out.node_radiance[out.node_index(lev, c, m, node, 0)] * std::cos(m * phi) +
-                             out.node_radiance[out.node_index(lev, c, m, node, 1)] * std::sin(m * phi);
-                    const std::array<double, 9> y = sh_basis(look_direction(mv, phi));
-                    for (int k = 0; k < 9; ++k) sh[size_t(k)] += w[size_t(j)] * 2.0 * kPi / az * l * y[size_t(k)];
+    for (int g = 0; g < groups; ++g)
+        for (int lev = 0; lev < levels; ++lev)
+            for (int c = 0; c < 3; ++c) {
+                MultipleScatteringField& o = *target[g];
+                std::array<double, 9> sh{};
+                for (int node = 0; node < 2 * n; ++node) {
+                    const int j = node % n;
+                    const double mv = node < n ? mu[size_t(j)] : -mu[size_t(j)];
+                    for (int s = 0; s < az; ++s) {
+                        const double phi = 2.0 * kPi * s / az;
+                        double l = 0.0;
+                        for (int m = 0; m < std::min(3, modes); ++m)
+                            l += o.node_radiance[o.node_index(lev, c, m, node, 0)] * std::cos(m * phi) +
+                                 o.node_radiance[o.node_index(lev, c, m, node, 1)] * std::sin(m * phi);
+                        const std::array<double, 9> y = sh_basis(look_direction(mv, phi));
+                        for (int k = 0; k < 9; ++k) sh[size_t(k)] += w[size_t(j)] * 2.0 * kPi / az * l * y[size_t(k)];
+                    }
                 }
+                if (sun && target[g] == &sun_out) {
+                    const std::array<double, 9> y = sh_basis(look_direction(sun_mu, 0.0));
+                    for (int k = 0; k < 9; ++k)
+                        sh[size_t(k)] += o.sun_forward_irradiance[size_t(lev)][size_t(c)] * y[size_t(k)];
+                }
+                o.radiance_sh[size_t(lev)][size_t(c)] = sh;
             }
-            if (sun) {
-                const std::array<double, 9> y = sh_basis(look_direction(sun_mu, 0.0));
-                for (int k = 0; k < 9; ++k)
-                    sh[size_t(k)] += out.sun_forward_irradiance[size_t(lev)][size_t(c)] * y[size_t(k)];
-            }
-            out.radiance_sh[size_t(lev)][size_t(c)] = sh;
-        }
     out.solve_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+    sun_out.solve_seconds = out.solve_seconds;
     return out;
+}
+
+}  // namespace
+
+MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atm, const SlabIllumination& light,
+                                             const SolverOptions& opt) {
+    return solve_sources(atm, light, opt, nullptr);
+}
+
+FieldBySource solve_plane_parallel_by_source(const SlabAtmosphere& atm, const SlabIllumination& light,
+                                             const SolverOptions& opt) {
+    FieldBySource parts;
+    parts.sky = solve_sources(atm, light, opt, &parts.sun);
+    return parts;
 }
 
 namespace {

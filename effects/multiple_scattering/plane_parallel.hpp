@@ -158,6 +158,18 @@ std::array<double, 9> sh_basis(const std::array<double, 3>& w);
 MultipleScatteringField solve_plane_parallel(const SlabAtmosphere& atmosphere, const SlabIllumination& light,
                                              const SolverOptions& options = {});
 
+// The field in two parts by source, in one solve (the layers' operators are
+// shared): `sky` the sky dome's light (and the ground's reflection of it),
+// `sun` the sun's. The transfer is linear in its sources, so their sum is
+// solve_plane_parallel's field (up to rounding), and the sun's part scales
+// with each channel's sun_irradiance: a sun that brightens or dims re-uses it
+// (effects/multiple_scattering/physics.md eq. 9.4).
+struct FieldBySource {
+    MultipleScatteringField sky, sun;
+};
+FieldBySource solve_plane_parallel_by_source(const SlabAtmosphere& atmosphere, const SlabIllumination& light,
+                                             const SolverOptions& options = {});
+
 // The renderer's atmosphere (make_species_gpu) as slab layers between the
 // given altitudes: optical depths integrated exactly over each profile piece;
 // phases Rayleigh for molecules, HG for aerosol and rain (the HG that

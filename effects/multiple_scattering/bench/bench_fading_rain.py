@@ -16,6 +16,12 @@ effects/multiple_scattering/physics.md eq. 9.3), error and cost in one run:
    down to 0.05, geometric) of the sun-10 rain-40 weather, a 64 x 36 street view, on the CPU: the
    time of the whole sequence and the number of solves, for N = 0 and each N. A fresh process
    per setting, so that nothing is cached in between.
+4. The sun coming out (``--parts sun``; physics.md eq. 9.4): ``--frames`` frames of the same
+   weather and view whose sun's irradiance rises from 0 to the scene's along the smoothstep of
+   ``airlight-demo --sequence rain-ends`` (over the first 40 % of the frames), the rain fixed; then
+   that demo's whole sequence (the rain's density falling 100-fold as well) with N = 0 and each N.
+   Solves and time per sequence. Each frame whose sun lights the scene is one solve by source of
+   everything but the sun's irradiance, so a brightening sun alone costs one solve.
 """
 
 from __future__ import annotations
@@ -109,12 +115,17 @@ FADE_SCRIPT = textwrap.dedent("""
 """)
 
 
-def fade_cost(steps: list[int], frames: int) -> list[str]:
-    case = rain_cases()["day_rain40_sun10"]
-    scene = copy.deepcopy(case["scene"])
+def street_view() -> dict:
+    """The sun-10 rain-40 weather seen along a street, 64 x 36 (the sequences' scene)."""
+    scene = copy.deepcopy(rain_cases()["day_rain40_sun10"]["scene"])
     scene["film"] = {"width": 64, "height": 36}
     scene["camera"] = {"position": [0, 1.7, 0], "look_at": [0, 1.7 + 0.087, -1], "up": [0, 1, 0], "fov_y": 40}
     scene.setdefault("quality", {})
+    return scene
+
+
+def fade_cost(steps: list[int], frames: int) -> list[str]:
+    scene = street_view()
     lines = ["| N | frames | solves | sequence time (s) | per frame (ms) | speed-up against N = 0 |",
              "|---|---|---|---|---|---|"]
     exact = 0.0
@@ -125,6 +136,42 @@ def fade_cost(steps: list[int], frames: int) -> list[str]:
         exact = exact or r["seconds"]
         lines.append(f"| {n} | {frames} | {r['solves']} | {r['seconds']:.1f} | "
                      f"{1e3 * r['seconds'] / frames:.0f} | {exact / r['seconds']:.1f}x |")
+    return lines
+
+
+SUN_SCRIPT = textwrap.dedent("""
+    import json, sys, time
+    import airlight
+    scene, frames, steps = json.loads(sys.argv[1]), int(sys.argv[2]), int(sys.argv[3])
+    fade = sys.argv[4] == "1"
+    sun = list(scene["sun"]["irradiance"])
+    renderer = airlight.Renderer("cpu")
+    start = time.perf_counter()
+    for f in range(frames):
+        t = f / (frames - 1)
+        s = min(1.0, t / 0.4)  # cpp/demo.cpp run_rain_ends: smoothstep over the first 40 %
+        scene["sun"]["irradiance"] = [e * s * s * (3 - 2 * s) for e in sun]
+        scene["atmosphere"]["rain"]["density_scale"] = 0.01 ** t if fade else 1.0
+        scene["quality"]["fading_rain_steps"] = steps
+        renderer.render(scene)
+    stats = airlight.table_stats()
+    print(json.dumps({"seconds": time.perf_counter() - start,
+                      "solves": stats.get("ms_field", {}).get("builds", 0)}))
+""")
+
+
+def sun_cost(steps: list[int], frames: int) -> list[str]:
+    scene = street_view()
+    lines = ["| sequence | N | frames | solves | sequence time (s) | per frame (ms) |",
+             "|---|---|---|---|---|---|"]
+    for fade, ns in ((False, [0]), (True, [0, *steps])):
+        for n in ns:
+            out = subprocess.run([sys.executable, "-c", SUN_SCRIPT, json.dumps(scene), str(frames), str(n),
+                                  "1" if fade else "0"], capture_output=True, text=True, check=True)
+            r = json.loads(out.stdout)
+            name = "sun comes out, rain fades 100-fold" if fade else "sun comes out, rain fixed"
+            lines.append(f"| {name} | {n} | {frames} | {r['solves']} | {r['seconds']:.1f} | "
+                         f"{1e3 * r['seconds'] / frames:.0f} |")
     return lines
 
 
@@ -144,6 +191,9 @@ def main() -> None:
     if "cost" in args.parts:
         report += [f"## Cost of a fade of {args.frames} frames (day_rain40_sun10 weather, 64 x 36, CPU)", "",
                    *fade_cost(args.steps, args.frames), ""]
+    if "sun" in args.parts:
+        title = f"## The sun coming out, {args.frames} frames (day_rain40_sun10 weather, 64 x 36, CPU)"
+        report += [title, "", *sun_cost(args.steps, args.frames), ""]
     text = "\n".join(report)
     print(text)
     if args.out:

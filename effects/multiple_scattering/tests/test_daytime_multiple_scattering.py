@@ -286,6 +286,40 @@ def test_a_fading_rain_shares_its_solves() -> None:
     assert thin[0]["builds"]["ms_field"] == 1 and "ms_field_rain_blend" not in thin[0]["builds"]
 
 
+def sunlit_street(scale: float) -> dict:
+    """A rainy street whose sun shines at ``scale`` times its irradiance (0: behind the clouds)."""
+    scene = street({"molecules": {"density_scale": 1}, "rain": {"rate": 20}}, GROUND + WALL)
+    scene["sun"]["irradiance"] = [scale * e for e in ms_cases.SUN_IRRADIANCE]
+    return scene
+
+
+def test_a_brightening_sun_shares_its_solve() -> None:
+    """The sun coming out (its irradiance 0 to 1 of the scene's, all else fixed) solves the field
+    twice: the sky alone while the sun is out of the scene, then once by source (eq. 9.4), each
+    frame adding the sun's part at its own irradiance."""
+    frames = fresh_process_renders([sunlit_street(s) for s in (0.0, 0.1, 0.4, 0.7, 1.0)])
+    assert frames[-1]["builds"]["ms_field"] == 2 and frames[-1]["builds"]["ms_field_sunlit"] == 4, frames[-1]
+    assert frames[0]["builds"]["ms_field"] == 1 and "ms_field_sunlit" not in frames[0]["builds"]
+
+
+@pytest.mark.parametrize("backend", airlight.available_backends())
+def test_the_image_is_linear_in_the_suns_irradiance(backend: str) -> None:
+    """Everything the sun lights is linear in its irradiance, so a frame at a share s of it is the
+    sunless frame plus s times the sun's light: the sky's part of the by-source solve agrees with the
+    sky solved alone, and the sun's part is scaled per channel (a reddened sun included)."""
+    renderer = airlight.Renderer(backend)
+    dark, full = renderer.render(sunlit_street(0.0))[..., :3], renderer.render(sunlit_street(1.0))[..., :3]
+    for s in (0.05, 0.3, 0.8):
+        np.testing.assert_allclose(renderer.render(sunlit_street(s))[..., :3], dark + s * (full - dark),
+                                   rtol=2e-4, atol=1e-6 * float(full.max()), err_msg=f"share {s}")
+    red = sunlit_street(1.0)
+    tint = np.array([1.0, 0.5, 0.2], np.float32)
+    red["sun"]["irradiance"] = [float(e * w) for e, w in zip(ms_cases.SUN_IRRADIANCE, tint)]
+    np.testing.assert_allclose(renderer.render(red)[..., :3], dark + (full - dark) * tint, rtol=2e-4,
+                               atol=1e-6 * float(full.max()))
+    renderer.close()
+
+
 @pytest.mark.parametrize("steps", [-1, 17, 2.5, "4"])
 def test_fading_rain_steps_out_of_range_is_a_clear_error(steps) -> None:
     scene = faded(DAY["day_rain40_overcast"], 0, 1.0, 0)

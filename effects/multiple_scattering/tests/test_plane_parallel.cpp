@@ -468,9 +468,13 @@ void check_renderer_atmosphere() {
     for (int c = 0; c < 3; ++c)
         worst = std::max({worst, std::abs(energy_defect(fa, c)), std::abs(energy_defect(fb, c))});
     const double layering = std::abs(fa.irradiance_down[0][1] / fb.irradiance_down[0][1] - 1.0);
-    if (g_print)
-        std::printf("40 mm/h rain: rain depth %.2f, %zu / %zu layers, energy %.2e, layering %.2e, solve %.3f s\n", ca,
-                    a.layers.size(), b.layers.size(), worst, layering, fa.solve_seconds);
+    if (g_print) {
+        const FieldBySource parts = solve_plane_parallel_by_source(a, s);  // eq. 9.4's cost: the same operators
+        std::printf(
+            "40 mm/h rain: rain depth %.2f, %zu / %zu layers, energy %.2e, layering %.2e, solve %.3f s, "
+            "by source %.3f s\n",
+            ca, a.layers.size(), b.layers.size(), worst, layering, fa.solve_seconds, parts.sky.solve_seconds);
+    }
     CHECK_MSG(worst < 5e-3, std::to_string(worst));
     CHECK_MSG(layering < 2e-3, std::to_string(layering));
     // Threads over the channels give the same numbers.
@@ -478,6 +482,89 @@ void check_renderer_atmosphere() {
     threaded.threads = 3;
     const MultipleScatteringField ft = solve_plane_parallel(a, s, threaded);
     CHECK(ft.phased_radiance == fa.phased_radiance && ft.node_radiance == fa.node_radiance);
+}
+
+// The largest difference between two fields' outputs, relative to the largest
+// value of `b` in each output; `sum` adds field c to a first (a + c against b).
+double field_difference(const MultipleScatteringField& a, const MultipleScatteringField& b,
+                        const MultipleScatteringField* c = nullptr) {
+    double worst = 0.0;
+    auto compare = [&](const std::vector<double>& x, const std::vector<double>& y, const std::vector<double>* z) {
+        CHECK(x.size() == y.size());
+        double scale = 1e-300, diff = 0.0;
+        for (size_t k = 0; k < y.size(); ++k) {
+            scale = std::max(scale, std::abs(y[k]));
+            diff = std::max(diff, std::abs(x[k] + (z ? (*z)[k] : 0.0) - y[k]));
+        }
+        worst = std::max(worst, diff / scale);
+    };
+    auto flat = [](const std::vector<RgbD>& v) {
+        std::vector<double> out;
+        for (const RgbD& x : v) out.insert(out.end(), x.begin(), x.end());
+        return out;
+    };
+    auto flat_sh = [](const MultipleScatteringField& f) {
+        std::vector<double> out;
+        for (const auto& level : f.radiance_sh)
+            for (const auto& channel : level) out.insert(out.end(), channel.begin(), channel.end());
+        return out;
+    };
+    auto vec = [](const RgbD& x) { return std::vector<double>(x.begin(), x.end()); };
+    compare(a.phased_radiance, b.phased_radiance, c ? &c->phased_radiance : nullptr);
+    compare(a.node_radiance, b.node_radiance, c ? &c->node_radiance : nullptr);
+    for (auto member :
+         {&MultipleScatteringField::irradiance_down, &MultipleScatteringField::irradiance_up,
+          &MultipleScatteringField::sun_direct_irradiance, &MultipleScatteringField::sky_direct_irradiance,
+          &MultipleScatteringField::sun_forward_irradiance}) {
+        const std::vector<double> cz = c ? flat(c->*member) : std::vector<double>();
+        compare(flat(a.*member), flat(b.*member), c ? &cz : nullptr);
+    }
+    const std::vector<double> csh = c ? flat_sh(*c) : std::vector<double>(), cf = c ? vec(c->incident_flux) : cf;
+    compare(flat_sh(a), flat_sh(b), c ? &csh : nullptr);
+    compare(vec(a.incident_flux), vec(b.incident_flux), c ? &cf : nullptr);
+    return worst;
+}
+
+// The field by source (solve_plane_parallel_by_source): the sky's part is the
+// solve without the sun, the sun's the solve without the sky (each stops its
+// azimuth modes on its own light), and the sun's part scales with each
+// channel's irradiance, all to rounding; their sum is the solve with both up to
+// where that solve stopped its modes (the azimuth tolerance, 1e-4 of mode 0).
+void check_field_by_source() {
+    SlabIllumination both = sun_only(0.4);
+    both.sun_irradiance = {1.0, 0.7, 0.4};
+    both.ground_albedo = {0.3, 0.2, 0.1};
+    both.sky_radiance = [](double mu, double phi) {
+        const double v = (1.0 + 2.0 * mu) * (1.0 + 0.5 * std::cos(phi) + 0.3 * std::sin(phi));
+        return RgbD{0.05 * v, 0.08 * v, 0.1 * v};
+    };
+    SlabAtmosphere atm = slab(3.0, 0.9, PhaseFunction::henyey_greenstein(0.75), 3);
+    atm.phases.push_back(PhaseFunction::rayleigh());
+    for (SlabLayer& l : atm.layers) {
+        l.extinction_depth.push_back(RgbD{0.3, 0.2, 0.1});
+        l.scattering_depth.push_back(RgbD{0.3, 0.2, 0.1});
+    }
+    SlabIllumination sky_only = both, sun_alone = both, brighter = both;
+    sky_only.sun_irradiance = {0.0, 0.0, 0.0};
+    sun_alone.sky_radiance = nullptr;
+    brighter.sun_irradiance = {2.0, 1.4, 0.8};
+    const FieldBySource parts = solve_plane_parallel_by_source(atm, both);
+    const FieldBySource doubled = solve_plane_parallel_by_source(atm, brighter);
+    const double sum = field_difference(parts.sky, solve_plane_parallel(atm, both), &parts.sun);
+    const double sky = field_difference(parts.sky, solve_plane_parallel(atm, sky_only));
+    const double sun = field_difference(parts.sun, solve_plane_parallel(atm, sun_alone));
+    const double scale = field_difference(parts.sun, doubled.sun, &parts.sun);
+    const double same_sky = field_difference(doubled.sky, parts.sky);
+    if (g_print)
+        std::printf("by source: sum %.1e, sky %.1e, sun %.1e, sun scaling %.1e, sky unchanged %.1e\n", sum, sky, sun,
+                    scale, same_sky);
+    CHECK_MSG(sum < 1e-4, std::to_string(sum));
+    CHECK_MSG(sky < 1e-12, std::to_string(sky));
+    CHECK_MSG(sun < 1e-12, std::to_string(sun));
+    CHECK_MSG(scale < 1e-12, std::to_string(scale));
+    CHECK_MSG(same_sky == 0.0, std::to_string(same_sky));
+    // Each part has light of its own.
+    CHECK(parts.sky.irradiance_down[0][1] > 0.0 && parts.sun.irradiance_down[0][1] > 0.0);
 }
 
 // Tilted surfaces: the l <= 2 harmonics against quadrature of the ordinates.
@@ -683,6 +770,7 @@ int main(int argc, char** argv) {
     check_azimuth_mirror();
     check_two_species();
     check_renderer_atmosphere();
+    check_field_by_source();
     check_tilted_irradiance();
     check_convergence();
     check_altitude_interpolation();
