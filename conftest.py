@@ -7,6 +7,7 @@ from __future__ import annotations
 
 import copy
 import json
+import os
 import subprocess
 import sys
 from pathlib import Path
@@ -23,6 +24,12 @@ for _dir in TEST_DIRS:
         sys.path.insert(0, str(_dir))
 
 BACKENDS = ("cpu", "gl")
+
+# Mesa's llvmpipe compiles each shader variant single-threaded, and on a cold shader cache (every CI
+# machine) that compile is most of a GL test's time. Without LLVM's optimisation passes it takes about
+# half as long and the images are bit-for-bit the same (measured on three presets); the shaders then run
+# up to 2x slower, which the tests' small films do not notice. scripts/test.sh sets it for ctest too.
+os.environ.setdefault("GALLIVM_PERF", "nopt")
 
 # Issue 18 turned multiple scattering on by default (quality.multiple_scattering). The tests written
 # before it check the single-scattering renderer against single-scattering references, so a scene with

@@ -164,7 +164,9 @@ def test_auto_tabulates_for_street_cameras_on_big_films(renderer, altitude, widt
 
 
 @pytest.mark.slow
-@settings(max_examples=25, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
+# 12 random scenes per backend (and the two corners below): on GL nearly each is a shader variant of its
+# own, compiled for seconds on a cold cache.
+@settings(max_examples=12, deadline=None, suppress_health_check=[HealthCheck.function_scoped_fixture])
 @given(
     nodes=st.integers(8, 64),
     rain=st.floats(0.0, 100.0),

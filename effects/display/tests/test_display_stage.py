@@ -281,7 +281,7 @@ def _glare_cases(draw: st.DrawFn) -> tuple[np.ndarray, dict]:
     return image.astype(np.float32), kwargs
 
 
-@settings(max_examples=60, deadline=None, suppress_health_check=[HealthCheck.too_slow])
+@settings(max_examples=30, deadline=None, suppress_health_check=[HealthCheck.too_slow])
 @given(case=_glare_cases())
 def test_glare_shortcuts_never_move_a_value_by_more_than_one_step(case: tuple[np.ndarray, dict]) -> None:
     image, kwargs = case

@@ -7,12 +7,12 @@ pixels above 1e-3 of the image's maximum)."""
 from __future__ import annotations
 
 import copy
-import functools
 from typing import Any
 
 import clouds_reference as ref
 import numpy as np
 import pytest
+from shared_results import computed_once
 
 import airlight
 
@@ -42,14 +42,14 @@ def scene_for(camera: str) -> dict[str, Any]:
     return scene
 
 
-@functools.cache
 def reference(camera: str) -> tuple[np.ndarray, np.ndarray]:
-    """(the clouds layer, the clouds' transmittance), float64, cached for the session."""
-    shape, detail = airlight._core.cloud_noise_textures(0)
-    scene = scene_for(camera)
-    light = ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail)
-    through = ref.clouds_transmittance(scene, WIDTH, HEIGHT, shape, detail)
-    return light, through
+    """(the clouds layer, the clouds' transmittance), float64, once per test run."""
+    def compute() -> tuple[np.ndarray, np.ndarray]:
+        shape, detail = airlight._core.cloud_noise_textures(0)
+        scene = scene_for(camera)
+        return (ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail),
+                ref.clouds_transmittance(scene, WIDTH, HEIGHT, shape, detail))
+    return computed_once(f"clouds_reference_{camera}", compute)
 
 
 def relative_errors(image: np.ndarray, exact: np.ndarray) -> tuple[np.ndarray, str]:
@@ -183,18 +183,32 @@ def test_clouds_shadow_the_fog_below_them_like_the_float64_reference(renderer):
     assert errors[128][0] <= 0.002 and errors[128][1] <= 0.01, errors
 
 
+def second_lobe_scene() -> dict[str, Any]:
+    scene = scene_for("above")
+    scene["clouds"].update(second_g=-0.5, second_weight=0.3, powder=0.8)
+    scene["sun"] = {"elevation": 40, "azimuth": 180, "irradiance": [12, 11.5, 10.5]}
+    return scene
+
+
+def second_lobe_references() -> tuple[np.ndarray, np.ndarray]:
+    """The float64 clouds layer with the second lobe and powder, and without (45 s each), once per
+    test run for both backends."""
+    def compute() -> tuple[np.ndarray, np.ndarray]:
+        shape, detail = airlight._core.cloud_noise_textures(0)
+        scene = second_lobe_scene()
+        plain = copy.deepcopy(scene)
+        plain["clouds"].update(second_weight=0.0, powder=0.0)
+        return (ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail),
+                ref.clouds_layer_radiance(plain, WIDTH, HEIGHT, shape, detail))
+    return computed_once("clouds_second_lobe_references", compute)
+
+
 @pytest.mark.slow
 def test_second_lobe_and_powder_match_the_float64_reference(renderer):
     """The options of physics.md eqs. 3.4 (a backward second lobe) and 3.5 (the powder term),
     seen from above the layer with the sun behind the camera, where both matter."""
-    scene = scene_for("above")
-    scene["clouds"].update(second_g=-0.5, second_weight=0.3, powder=0.8)
-    scene["sun"] = {"elevation": 40, "azimuth": 180, "irradiance": [12, 11.5, 10.5]}
-    shape, detail = airlight._core.cloud_noise_textures(0)
-    light = ref.clouds_layer_radiance(scene, WIDTH, HEIGHT, shape, detail)
-    plain = copy.deepcopy(scene)
-    plain["clouds"].update(second_weight=0.0, powder=0.0)
-    plain_light = ref.clouds_layer_radiance(plain, WIDTH, HEIGHT, shape, detail)
+    scene = second_lobe_scene()
+    light, plain_light = second_lobe_references()
     assert np.abs(light - plain_light).max() > 0.1 * plain_light.max()  # the options change the image
     scene["quality"] = dict(ACCURATE)
     rel, where = relative_errors(renderer.render(scene, outputs=["clouds"])["clouds"], light)
