@@ -13,7 +13,7 @@ export PATH="$PWD/.venv/bin:$PATH"
 export GALLIVM_PERF="${GALLIVM_PERF:-nopt}"
 cmake -S . -B build/cpp -G Ninja -DAIRLIGHT_BUILD_TESTS=ON -DCMAKE_BUILD_TYPE=Release >/dev/null
 cmake --build build/cpp
-ctest --test-dir build/cpp --output-on-failure
+ctest --test-dir build/cpp --output-on-failure --parallel "$(nproc)"
 ruff check python tests benchmarks examples effects tools conftest.py
 mypy python/airlight
 clang-format --dry-run --Werror cpp/*.cpp cpp/*.hpp include/airlight/*.hpp tests/cpp/*.cpp tests/cpp/*.hpp effects/*/*.cpp effects/*/*.hpp effects/*/tests/*.cpp
