@@ -27,6 +27,7 @@
 #include "frame_data.hpp"
 #include "ms_tables.hpp"
 #include "noise.hpp"
+#include "numerics.hpp"
 #include "particle_field.hpp"
 #include "particle_table.hpp"
 #include "phase_tables.hpp"
@@ -596,16 +597,25 @@ PYBIND11_MODULE(_core, m) {
             const double* o = origins.data();
             const double* d = dirs.data();
             double* r = out.mutable_data();
+            // The rays in the solver's frame, checked first; then marched on every core.
+            std::vector<double> frame_rays(size_t(n) * 6);
             for (py::ssize_t i = 0; i < n; ++i) {
-                double oo[3], dd[3];
+                double* oo = &frame_rays[size_t(i) * 6];
+                double* dd = oo + 3;
                 to_frame(o + 3 * i, oo);
                 to_frame(d + 3 * i, dd);
                 const double len = std::sqrt(dd[0] * dd[0] + dd[1] * dd[1] + dd[2] * dd[2]);
                 if (!(len > 0.0) || !std::isfinite(len))
                     throw py::value_error("dirs: every row must be a nonzero finite vector");
-                for (double& x : dd) x /= len;
-                const std::vector<double> orders = solved->radiance_orders(oo, dd, steps);
-                std::copy(orders.begin(), orders.end(), r + i * columns);
+                for (int k = 0; k < 3; ++k) dd[k] /= len;
+            }
+            {
+                py::gil_scoped_release release;
+                airlight::numerics::parallel_for(int(n), [&](int i) {
+                    const double* ray = &frame_rays[size_t(i) * 6];
+                    const std::vector<double> orders = solved->radiance_orders(ray, ray + 3, steps);
+                    std::copy(orders.begin(), orders.end(), r + size_t(i) * columns);
+                });
             }
             return out;
         },

@@ -121,12 +121,12 @@ struct SphereScattering::Impl {
     int dirs, positions;
     // J_k for k >= 2 (eq. 2.8): peak[p] p_{g^k}(sun . v) + rest[p][direction] at the nodes.
     struct OrderSource {
-        std::vector<float> peak;  // e_k at each position node
-        std::vector<float> rest;  // R_k, [position][direction]
+        std::vector<float> peak;  // e_k at each position node; empty where there is none
+        std::vector<float> rest;  // R_k, in the field layout (field_index)
         double peak_g;            // g^k
     };
     std::vector<OrderSource> source;  // source[k - 2]
-    // The orders >= 2 summed, for single_and_multiple: sum_k R_k on the grid and e_k by position.
+    // The orders >= 2 summed, for single_and_multiple: sum_k R_k on the grid (the field layout) and e_k by position.
     std::vector<float> rest_sum;
     std::vector<float> peaks;  // [position][k - 2]
     // Every order beyond grid.orders summed (eq. 2.11; its peak 0, on the grid whole), when grid.beyond.
@@ -156,6 +156,13 @@ struct SphereScattering::Impl {
     double polar_angle(int j) const { return polar_angles[size_t(j)]; }
     double zenith_angle(int k) const { return kPi * k / (grid.zenith - 1); }
     double azimuth_angle(int l) const { return kPi * l / (grid.azimuth - 1); }
+    // Where a field on the grid (R_k) holds position node `position` (radius * polar + polar node) and
+    // direction node `direction`: [radius][direction][polar], so that the polar taps of one lookup
+    // (eq. 2.13) lie side by side in memory. The march reads 16 position taps per sample; with the
+    // polar node fastest they share cache lines.
+    size_t field_index(int position, int direction) const {
+        return (size_t(position / grid.polar) * dirs + direction) * grid.polar + position % grid.polar;
+    }
 
     // The local frame at y: outward normal n, t toward the sun in the tangent plane, b = n x t (section 2.3).
     static void frame(const Vec& y, Vec& n, Vec& t, Vec& b) {
@@ -180,14 +187,21 @@ struct SphereScattering::Impl {
     // Eq. 2.13: the position nodes around a grid point and their weights, a Catmull-Rom cubic in the
     // radial index and in the polar angle. Not linear: a linear interpolant's kinks act as extra
     // diffusion in a thick particle (physics.md section 2.3). Past a pole the mirror node stands in,
-    // past the centre the missing node is continued linearly.
+    // past the centre the missing node is continued linearly. Always 4 x 4 taps (a tap that the
+    // continuation empties keeps weight 0 on a valid node), so that the loops over them unroll.
     struct PositionTaps {
-        int count = 0;
-        std::array<int, 16> position;
-        std::array<double, 16> weight;
+        std::array<int, 4> radial, polar;  // node indices
+        std::array<double, 4> radial_weight, polar_weight;
+        // Calls visit(position, weight) for every tap (position = radius * polar + polar node).
+        template <class Visit>
+        void for_each(int polar_nodes, const Visit& visit) const {
+            for (int a = 0; a < 4; ++a)
+                for (int b = 0; b < 4; ++b)
+                    visit(radial[a] * polar_nodes + polar[b], radial_weight[a] * polar_weight[b]);
+        }
     };
-    static int cubic_taps(int node, double f, int n, bool mirror, std::array<int, 4>& index,
-                          std::array<double, 4>& weight) {
+    static void cubic_taps(int node, double f, int n, bool mirror, std::array<int, 4>& index,
+                           std::array<double, 4>& weight) {
         const double f2 = f * f, f3 = f2 * f;
         std::array<double, 4> w{0.5 * (-f3 + 2 * f2 - f), 0.5 * (3 * f3 - 5 * f2 + 2), 0.5 * (-3 * f3 + 4 * f2 + f),
                                 0.5 * (f3 - f2)};
@@ -204,43 +218,40 @@ struct SphereScattering::Impl {
         };
         if (at[0] < 0) stand_in(0, 1, 2, std::min(1, n - 1));
         if (at[3] > n - 1) stand_in(3, 2, 1, std::max(0, n - 2));
-        int count = 0;
-        for (int i = 0; i < 4; ++i)
-            if (w[i] != 0.0) {
-                index[count] = at[i];
-                weight[count++] = w[i];
-            }
-        return count;
+        for (int i = 0; i < 4; ++i) {
+            index[i] = std::clamp(at[i], 0, n - 1);  // a continued end's node: weight 0
+            weight[i] = w[i];
+        }
     }
     PositionTaps position_taps(int node_r, double frac_r, int node_p, double frac_p) const {
-        std::array<int, 4> ri, pi;
-        std::array<double, 4> rw, pw;
-        const int nr = cubic_taps(node_r, frac_r, grid.radii, false, ri, rw);
-        const int np = cubic_taps(node_p, frac_p, grid.polar, true, pi, pw);
         PositionTaps taps;
-        for (int a = 0; a < nr; ++a)
-            for (int b = 0; b < np; ++b) {
-                const double weight = rw[a] * pw[b];
-                if (weight == 0.0) continue;
-                taps.position[taps.count] = ri[a] * grid.polar + pi[b];
-                taps.weight[taps.count++] = weight;
-            }
+        cubic_taps(node_r, frac_r, grid.radii, false, taps.radial, taps.radial_weight);
+        cubic_taps(node_p, frac_p, grid.polar, true, taps.polar, taps.polar_weight);
         return taps;
     }
     PositionTaps position_taps(const GridPoint& p) const {
         return position_taps(p.node[0], p.frac[0], p.node[1], p.frac[1]);
     }
-    // A field on the grid ([position][direction]) at the taps, bilinear in the direction (zenith, azimuth
+    // A field on the grid (the field layout) at the taps, bilinear in the direction (zenith, azimuth
     // nodes and fractions).
     double interpolate(const std::vector<float>& field, const PositionTaps& taps, int zenith_node, double zenith_frac,
                        int azimuth_node, double azimuth_frac) const {
         const int d = zenith_node * grid.azimuth + azimuth_node;
-        const double w00 = (1 - zenith_frac) * (1 - azimuth_frac), w01 = (1 - zenith_frac) * azimuth_frac,
-                     w10 = zenith_frac * (1 - azimuth_frac), w11 = zenith_frac * azimuth_frac;
+        const std::array<int, 4> corner{0, 1, grid.azimuth, grid.azimuth + 1};  // direction nodes around d
+        const std::array<double, 4> corner_weight{(1 - zenith_frac) * (1 - azimuth_frac),
+                                                  (1 - zenith_frac) * azimuth_frac, zenith_frac * (1 - azimuth_frac),
+                                                  zenith_frac * azimuth_frac};
         double sum = 0.0;
-        for (int i = 0; i < taps.count; ++i) {
-            const float* f = &field[size_t(taps.position[i]) * dirs + d];
-            sum += taps.weight[i] * (w00 * f[0] + w01 * f[1] + w10 * f[grid.azimuth] + w11 * f[grid.azimuth + 1]);
+        for (int a = 0; a < 4; ++a) {
+            const float* at_radius = &field[(size_t(taps.radial[a]) * dirs + d) * grid.polar];
+            double by_direction = 0.0;
+            for (int c = 0; c < 4; ++c) {
+                const float* f = at_radius + size_t(corner[c]) * grid.polar;
+                double by_polar = 0.0;
+                for (int b = 0; b < 4; ++b) by_polar += taps.polar_weight[b] * f[taps.polar[b]];
+                by_direction += corner_weight[c] * by_polar;
+            }
+            sum += taps.radial_weight[a] * by_direction;
         }
         return sum;
     }
@@ -248,19 +259,23 @@ struct SphereScattering::Impl {
         return interpolate(field, position_taps(p), p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
     // A field by position only (a peak coefficient) at the taps.
-    static double interpolate(const float* by_position, const PositionTaps& taps) {
+    // e_k at the taps; 0 for a source without a peak (the orders beyond, eq. 2.11).
+    double peak_at(const OrderSource& o, const PositionTaps& taps) const {
+        return o.peak.empty() ? 0.0 : interpolate(o.peak.data(), taps);
+    }
+    double interpolate(const float* by_position, const PositionTaps& taps) const {
         double sum = 0.0;
-        for (int i = 0; i < taps.count; ++i) sum += taps.weight[i] * by_position[taps.position[i]];
+        taps.for_each(grid.polar, [&](int position, double weight) { sum += weight * by_position[position]; });
         return sum;
     }
     // J_k at grid point p toward an observer looking along w, from its grid (eq. 2.8).
-    double order_source(const OrderSource& o, const GridPoint& p, const Vec& w) const {
-        const PositionTaps taps = position_taps(p);
-        return interpolate(o.peak.data(), taps) * hg_of(o.peak_g, w.z) +
+    double order_source(const OrderSource& o, const GridPoint& p, const PositionTaps& taps, const Vec& w) const {
+        return peak_at(o, taps) * hg_of(o.peak_g, w.z) +
                interpolate(o.rest, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
     double order_source(const OrderSource& o, const Vec& x, const Vec& w) const {
-        return order_source(o, locate(x, w), w);
+        const GridPoint p = locate(x, w);
+        return order_source(o, p, position_taps(p), w);
     }
     Vec node_position(int position) const {
         const double r = radial.radius(position / grid.polar), th = polar_angle(position % grid.polar);
@@ -313,6 +328,28 @@ struct SphereScattering::Impl {
             first = false;
             t_prev = t;
             f_prev = f;
+        });
+        return sum;
+    }
+    // march() for `count` sources on the grid at once along the same ray, each sample located on the
+    // grid once: source(k, p, taps) is source k at grid point p with its position taps. The sums of
+    // march() for each source, in the same order of operations.
+    template <class Source>
+    std::vector<double> march_located(const Vec& y, const Vec& w, int steps, size_t count, const Source& source) const {
+        std::vector<double> sum(count, 0.0), f_prev(count, 0.0);
+        double t_prev = 0.0;
+        bool first = true;
+        march_points(y, w, steps, [&](double t) {
+            const GridPoint p = locate(y + t * w, w);
+            const PositionTaps taps = position_taps(p);
+            const double attenuation = std::exp(-tau * t);
+            for (size_t k = 0; k < count; ++k) {
+                const double f = source(k, p, taps) * attenuation;
+                if (!first) sum[k] += (t - t_prev) * log_mean(f_prev[k], f);
+                f_prev[k] = f;
+            }
+            first = false;
+            t_prev = t;
         });
         return sum;
     }
@@ -408,26 +445,36 @@ struct SphereScattering::Impl {
 
     // A sample of a node ray located on the grid once, for every order's march (eq. 2.6): the grid
     // cell (its lower node and the fraction toward the next, 1/65535 steps, per axis r, polar, zenith,
-    // azimuth) and the distance t along the ray.
+    // azimuth), the distance t along the ray, and the sample's weight in the march that takes the
+    // source as linear between samples (eq. 2.12: its share of the two steps it ends and begins).
     struct PlannedSample {
         int16_t node[4];
         uint16_t frac[4];
         float t;
+        float linear_weight;
     };
     int samples_per_ray() const { return 2 * grid.march_steps + 1; }
     // Fills the samples of the ray from y along w (all with t = 0 when the ray leaves at once).
     void plan_ray(const Vec& y, const Vec& w, PlannedSample* out) const {
         int n = 0;
+        double t_prev = 0.0, weight_prev = 0.0;
         march_points(y, w, grid.march_steps, [&](double t) {
             const GridPoint p = locate(y + t * w, w);
-            PlannedSample& s = out[n++];
+            PlannedSample& s = out[n];
             for (int axis = 0; axis < 4; ++axis) {
                 s.node[axis] = int16_t(p.node[axis]);
                 s.frac[axis] = uint16_t(std::lround(p.frac[axis] * 65535.0));
             }
             s.t = float(t);
+            // Step [t_prev, t] gives its first weight to the sample before and its second to this one.
+            const std::array<double, 2> step = n > 0 ? linear_step_weights(t_prev, t) : std::array<double, 2>{0.0, 0.0};
+            if (n > 0) out[n - 1].linear_weight = float(weight_prev + step[0]);
+            weight_prev = step[1];
+            t_prev = t;
+            ++n;
         });
-        for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{{0, 0, 0, 0}, {0, 0, 0, 0}, 0.0f};
+        if (n > 0) out[n - 1].linear_weight = float(weight_prev);
+        for (; n < samples_per_ray(); ++n) out[n] = PlannedSample{{0, 0, 0, 0}, {0, 0, 0, 0}, 0.0f, 0.0f};
     }
     // Eq. 2.6 over planned samples of the ray whose direction has sun . w = cos_sun. With `linear`, the
     // source is linear between samples instead, its product with the exact exponential integrated
@@ -442,15 +489,10 @@ struct SphereScattering::Impl {
             double frac[4];
             for (int axis = 0; axis < 4; ++axis) frac[axis] = s.frac[axis] / 65535.0;
             const PositionTaps taps = position_taps(s.node[0], frac[0], s.node[1], frac[1]);
-            const double j = interpolate(o.peak.data(), taps) * peak_phase +
-                             interpolate(o.rest, taps, s.node[2], frac[2], s.node[3], frac[3]);
+            const double j =
+                peak_at(o, taps) * peak_phase + interpolate(o.rest, taps, s.node[2], frac[2], s.node[3], frac[3]);
             if (linear) {
-                if (i > 0) {
-                    const std::array<double, 2> w = linear_step_weights(t_prev, double(s.t));
-                    sum += w[0] * f_prev + w[1] * j;
-                }
-                f_prev = j;
-                t_prev = s.t;
+                sum += double(s.linear_weight) * j;
                 continue;
             }
             const double f = j * std::exp(-tau * double(s.t));
@@ -502,36 +544,44 @@ struct SphereScattering::Impl {
         auto gather = [&](const NodeRadiance& in, const OrderSource* made_by, double peak_g, bool split_peak) {
             OrderSource next{std::vector<float>(positions), std::vector<float>(size_t(positions) * dirs, 0.0f),
                              split_peak ? peak_g * g : 0.0};
-            numerics::parallel_for(positions, [&](int p) {
-                const double c = split_peak ? in.toward_sun[p] / hg_of(peak_g, 1.0) : 0.0;
-                next.peak[p] = float(tau * c);
-                float* out = &next.rest[size_t(p) * dirs];
-                const float* radiance = &in.radiance[size_t(p) * dirs];
-                const int ir = p / grid.polar;
+            // By radius: one thread writes all the polar nodes that share its cache lines (field_index).
+            numerics::parallel_for(grid.radii, [&](int ir) {
+                std::vector<float> out(dirs);
                 const float* weighted = &weights.by_radius[size_t(ir) * dirs * dirs];
-                const Vec y = node_position(p);
-                for (int j = 0; j < dirs; ++j) {
-                    // Eq. 2.10: I = U S with S smooth (the mean source along the ray; at U = 0 the source at y).
-                    const double u = node_meets[size_t(ir) * grid.zenith + j / grid.azimuth];
-                    const Vec w = node_direction(p, j);
-                    const double mean = u > 1e-7  ? radiance[j] / u
-                                        : made_by ? order_source(*made_by, y, w) / tau
-                                                  : single_source(y, w) / tau;
-                    const float a = float(tau * mean), b = float(-tau * c * hg_of(peak_g, w.z));
-                    const float* column = &weighted[size_t(j) * dirs];
-                    const float* plain = &weights.plain[size_t(j) * dirs];
-                    for (int i = 0; i < dirs; ++i) out[i] += a * column[i] + b * plain[i];
+                for (int p = ir * grid.polar; p < (ir + 1) * grid.polar; ++p) {
+                    const double c = split_peak ? in.toward_sun[p] / hg_of(peak_g, 1.0) : 0.0;
+                    next.peak[p] = float(tau * c);
+                    std::fill(out.begin(), out.end(), 0.0f);
+                    const float* radiance = &in.radiance[size_t(p) * dirs];
+                    const Vec y = node_position(p);
+                    for (int j = 0; j < dirs; ++j) {
+                        // Eq. 2.10: I = U S with S smooth (the mean source along the ray; at U = 0 the source at y).
+                        const double u = node_meets[size_t(ir) * grid.zenith + j / grid.azimuth];
+                        const Vec w = node_direction(p, j);
+                        const double mean = u > 1e-7  ? radiance[j] / u
+                                            : made_by ? order_source(*made_by, y, w) / tau
+                                                      : single_source(y, w) / tau;
+                        const float a = float(tau * mean), b = float(-tau * c * hg_of(peak_g, w.z));
+                        const float* column = &weighted[size_t(j) * dirs];
+                        const float* plain = &weights.plain[size_t(j) * dirs];
+                        for (int i = 0; i < dirs; ++i) out[i] += a * column[i] + b * plain[i];
+                    }
+                    for (int i = 0; i < dirs; ++i) next.rest[field_index(p, i)] = out[i];
                 }
             });
             return next;
         };
         // Eq. 2.4: an order's radiance at the nodes, marching its source.
+        std::vector<double> node_cos_sun(size_t(grid.polar) * dirs);  // sun . w of each polar and direction node
+        for (int pol = 0; pol < grid.polar; ++pol)
+            for (int d = 0; d < dirs; ++d) node_cos_sun[size_t(pol) * dirs + d] = node_direction(pol, d).z;
         auto march_nodes = [&](const OrderSource& field, NodeRadiance& out, bool linear) {
             numerics::parallel_for(positions, [&](int p) {
                 const PlannedSample* ray = &plan[size_t(p) * (dirs + 1) * per_ray];
+                const double* cos_sun = &node_cos_sun[size_t(p % grid.polar) * dirs];
                 for (int d = 0; d < dirs; ++d)
                     out.radiance[size_t(p) * dirs + d] =
-                        float(planned_march(ray + d * per_ray, field, node_direction(p, d).z, linear));
+                        float(planned_march(ray + d * per_ray, field, cos_sun[d], linear));
                 out.toward_sun[p] = float(planned_march(ray + dirs * per_ray, field, 1.0, linear));
             });
         };
@@ -557,9 +607,9 @@ struct SphereScattering::Impl {
         std::vector<double> rhs(size_t(positions) * dirs);
         for (int p = 0; p < positions; ++p)
             for (int d = 0; d < dirs; ++d)
-                rhs[size_t(p) * dirs + d] = first.rest[size_t(p) * dirs + d] +
-                                            double(first.peak[p]) * hg_of(first.peak_g, node_direction(p, d).z);
-        OrderSource field{std::vector<float>(positions, 0.0f), std::vector<float>(rhs.size()), 0.0};
+                rhs[field_index(p, d)] =
+                    first.rest[field_index(p, d)] + double(first.peak[p]) * hg_of(first.peak_g, node_direction(p, d).z);
+        OrderSource field{{}, std::vector<float>(rhs.size()), 0.0};  // no peak: all on the grid
         // x -> (1 - K) x.
         auto apply = [&](const std::vector<double>& x, std::vector<double>& out) {
             for (size_t i = 0; i < x.size(); ++i) field.rest[i] = float(x[i]);
@@ -575,7 +625,7 @@ struct SphereScattering::Impl {
 
     // GMRES (Saad and Schultz 1986; Arnoldi with modified Gram-Schmidt, Givens rotations) for M x = b,
     // M given by apply(x, out), from x = 0: stops at a residual of kBeyondTolerance |b| or after
-    // kBeyondIterations (the basis is kept whole: 2 MiB a vector at the default grid). M = 1 - K has its eigenvalues in
+    // kBeyondIterations (the basis is kept whole: 3 MiB a vector at the default grid). M = 1 - K has its eigenvalues in
     // (0, 2): K loses a little light each order, least in the slowest modes of a thick sphere (about pi^2 / (3 tau^2 (1
     // - g)) of it, the diffusion limit), which plain iteration would take thousands of orders to sum and a Krylov
     // method about the square root of that (physics.md section 2.7).
@@ -678,31 +728,25 @@ std::array<double, 4> SphereScattering::table_channels(const double origin[3], c
     // Order 1 over its phase (eq. 2.2: p(sun . v) is the same all along the ray).
     out[0] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->single_source(x, v); }) / impl_->hg(v.z);
     const size_t orders = impl_->source.size();
-    // e_k at x (eq. 2.8), for orders k = 2 and 3 by themselves.
-    auto peak_integral = [&](size_t k) {
-        return impl_->march(entry, v, steps, [&](const Vec& x) {
-            const GridPoint p = impl_->locate(x, v);
-            return Impl::interpolate(impl_->source[k].peak.data(), impl_->position_taps(p));
-        });
-    };
-    if (orders >= 1) out[1] = peak_integral(0);
-    if (orders >= 2) out[2] = peak_integral(1);
     if (orders == 0 && !impl_->grid.beyond) return out;
-    // The rest of orders >= 2 at once: the rests' sum and the peaks of orders >= 4.
+    // Located once per sample (march_located): e_2 and e_3 by themselves (eq. 2.8), then the rest of
+    // orders >= 2 at once: the rests' sum and the peaks of orders >= 4.
     std::vector<double> peak_phase(orders, 0.0);
     for (size_t k = 2; k < orders; ++k) peak_phase[k] = Impl::hg_of(impl_->source[k].peak_g, v.z);
-    out[3] = impl_->march(entry, v, steps, [&](const Vec& x) {
-        const GridPoint p = impl_->locate(x, v);
-        const Impl::PositionTaps taps = impl_->position_taps(p);
-        double peak = 0.0;
-        for (int i = 0; i < taps.count; ++i) {
-            const float* e = impl_->peaks.data() + size_t(taps.position[i]) * orders;
-            double sum = 0.0;
-            for (size_t k = 2; k < orders; ++k) sum += e[k] * peak_phase[k];
-            peak += taps.weight[i] * sum;
-        }
-        return peak + impl_->interpolate(impl_->rest_sum, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
-    });
+    const std::vector<double> sums = impl_->march_located(
+        entry, v, steps, 3, [&](size_t channel, const GridPoint& p, const Impl::PositionTaps& taps) {
+            if (channel < 2)
+                return channel < orders ? impl_->interpolate(impl_->source[channel].peak.data(), taps) : 0.0;
+            double peak = 0.0;
+            taps.for_each(impl_->grid.polar, [&](int position, double weight) {
+                const float* e = impl_->peaks.data() + size_t(position) * orders;
+                double sum = 0.0;
+                for (size_t k = 2; k < orders; ++k) sum += e[k] * peak_phase[k];
+                peak += weight * sum;
+            });
+            return peak + impl_->interpolate(impl_->rest_sum, taps, p.node[2], p.frac[2], p.node[3], p.frac[3]);
+        });
+    for (int c = 0; c < 3; ++c) out[c + 1] = sums[c];
     return out;
 }
 
@@ -712,13 +756,13 @@ std::vector<double> SphereScattering::radiance_orders(const double origin[3], co
     Vec entry;
     if (!sphere_entry(o, v, entry)) return out;
     out[0] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->single_source(x, v); });
-    for (size_t k = 0; k < impl_->source.size(); ++k) {
-        const Impl::OrderSource& field = impl_->source[k];
-        out[k + 1] = impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->order_source(field, x, v); });
-    }
-    if (impl_->grid.beyond)
-        out.back() =
-            impl_->march(entry, v, steps, [&](const Vec& x) { return impl_->order_source(impl_->beyond, x, v); });
+    // Orders 2.. (and the orders beyond, when solved), every sample located once.
+    const size_t fields = impl_->source.size() + (impl_->grid.beyond ? 1 : 0);
+    const std::vector<double> sums = impl_->march_located(
+        entry, v, steps, fields, [&](size_t k, const GridPoint& p, const Impl::PositionTaps& taps) {
+            return impl_->order_source(k < impl_->source.size() ? impl_->source[k] : impl_->beyond, p, taps, v);
+        });
+    std::copy(sums.begin(), sums.end(), out.begin() + 1);
     return out;
 }
 
