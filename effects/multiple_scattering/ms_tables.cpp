@@ -237,10 +237,12 @@ Table2D sunlit_table(const Table2D& parts, const glm::vec3& e) {
     const size_t half = size_t(t.width) * size_t(t.height) * 4;
     t.texels.assign(parts.texels.begin(), parts.texels.begin() + std::ptrdiff_t(half));
     const int altitude_row = layout_of(t).altitude_row;
-    for (int row = 0; row < t.height; ++row)
-        for (size_t i = size_t(row) * size_t(t.width) * 4;
-             i < size_t(row + 1) * size_t(t.width) * 4 && row != altitude_row; i += 4)
+    const size_t row_texels = size_t(t.width) * 4;
+    for (int row = 0; row < t.height; ++row) {
+        if (row == altitude_row) continue;  // the levels' altitudes, the same in both parts
+        for (size_t i = size_t(row) * row_texels; i < size_t(row + 1) * row_texels; i += 4)
             for (int c = 0; c < 3; ++c) t.texels[i + size_t(c)] += e[c] * parts.texels[half + i + size_t(c)];
+    }
     t.name = "ms_field_sunlit";
     t.build_seconds = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
     return t;

@@ -43,7 +43,8 @@ def main() -> None:
     ap.add_argument("--solver-only", action="store_true", help="skip the photon tracer")
     ap.add_argument("--out", default=None)
     args = ap.parse_args()
-    lines = [f"Energy left beyond order {args.orders} (photon tracer, {args.paths} paths per case; shares of "
+    tracer = "photon tracer skipped" if args.solver_only else f"photon tracer, {args.paths} paths per case"
+    lines = [f"Energy left beyond order {args.orders} ({tracer}; shares of "
              "the incident energy) and the solver's orders beyond (default grid)",
              f"{'tau':>6} {'g':>5} {'1 - T_direct':>13} {'orders 1..N':>12} {'beyond N':>10} "
              f"{'beyond / scattered':>19} {'missing vs sum':>15} {'solver beyond N':>16} "
