@@ -258,11 +258,11 @@ struct SphereScattering::Impl {
     double interpolate(const std::vector<float>& field, const GridPoint& p) const {
         return interpolate(field, position_taps(p), p.node[2], p.frac[2], p.node[3], p.frac[3]);
     }
-    // A field by position only (a peak coefficient) at the taps.
     // e_k at the taps; 0 for a source without a peak (the orders beyond, eq. 2.11).
     double peak_at(const OrderSource& o, const PositionTaps& taps) const {
         return o.peak.empty() ? 0.0 : interpolate(o.peak.data(), taps);
     }
+    // A field by position only (a peak coefficient) at the taps.
     double interpolate(const float* by_position, const PositionTaps& taps) const {
         double sum = 0.0;
         taps.for_each(grid.polar, [&](int position, double weight) { sum += weight * by_position[position]; });
