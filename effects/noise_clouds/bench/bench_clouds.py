@@ -44,6 +44,7 @@ import airlight
 
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE.parent / "tests"))
+sys.path.insert(0, str(HERE.parents[2] / "tests" / "python"))  # shared_results, which the tests import
 import clouds_reference  # noqa: E402
 import test_clouds_against_reference as cases  # noqa: E402
 

@@ -43,6 +43,7 @@ import numpy as np
 HERE = Path(__file__).resolve().parent
 sys.path.insert(0, str(HERE))
 sys.path.insert(0, str(HERE.parent / "tests"))
+sys.path.insert(0, str(HERE.parents[2] / "tests" / "python"))  # shared_results, which the tests import
 
 import clouds_reference as cr  # noqa: E402
 import fit_octaves as fo  # noqa: E402

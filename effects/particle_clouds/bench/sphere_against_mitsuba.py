@@ -80,7 +80,7 @@ import numpy as np
 import airlight
 
 HERE = Path(__file__).resolve().parent
-for _dir in (HERE, HERE.parent / "tests"):
+for _dir in (HERE, HERE.parent / "tests", HERE.parents[2] / "tests" / "python"):  # the last: shared_results
     if str(_dir) not in sys.path:
         sys.path.insert(0, str(_dir))
 

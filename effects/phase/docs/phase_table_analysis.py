@@ -44,7 +44,9 @@ import numpy as np
 from scipy.integrate import quad
 from scipy.special import ellipeinc
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+_EFFECTS = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+for _docs in ("lamp_airlight", "spotlights"):  # the analyses this one builds on live with their effects
+    sys.path.insert(0, os.path.join(_EFFECTS, _docs, "docs"))
 from airlight_table_analysis import Q_ref, bilinear_f32, build_S_table, geom_sets  # noqa: E402
 from spot_table_analysis import build_moment_tables, weighted_moments  # noqa: E402
 

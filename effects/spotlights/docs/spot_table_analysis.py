@@ -35,7 +35,9 @@ import time
 import numpy as np
 from scipy.integrate import quad
 
-sys.path.insert(0, os.path.dirname(os.path.abspath(__file__)))
+# The lamp airlight's analysis, whose table this one extends, lives with its effect.
+sys.path.insert(0, os.path.join(os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__)))),
+                                "lamp_airlight", "docs"))
 from airlight_table_analysis import Q_ref, bilinear_f32, build_S_table  # noqa: E402
 
 f32 = np.float32
