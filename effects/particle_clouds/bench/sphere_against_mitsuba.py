@@ -55,7 +55,8 @@ tau = 50, g = 0 sphere's shadowed side was 30-50 % low against sphere_paths foll
 (a one-off comparison, physics.md 2.6; sphere_against_tracer.py). The total's remaining
 failures (physics.md section 2.6): at tau = 50 the
 deepest shadow, 1e-3 of the brightest, 12-24 % darker than Mitsuba (within the numpy tracer's larger
-noise there), and g = 0.9 (the polar and direction grids: docs/sphere_grid_g09.txt).
+noise there), and g = 0.9 (the polar and direction grids:
+effects/particle_clouds/docs/sphere_grid_g09.txt).
 
 Runtime with --spp 262144 (15 cases, 25 rays, five depths): 74 minutes on 2 cores shared with other
 benchmarks (solver 548 s, Mitsuba 3863 s: without roulette the thick spheres' paths run to thousands
