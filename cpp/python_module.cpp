@@ -304,13 +304,14 @@ airlight::SphereGrid parse_sphere_grid(const py::dict& keys) {
             grid.surface_step = item.second.cast<double>();
             continue;
         }
-        int* field = key == "radii"         ? &grid.radii
-                     : key == "polar"       ? &grid.polar
-                     : key == "zenith"      ? &grid.zenith
-                     : key == "azimuth"     ? &grid.azimuth
-                     : key == "march_steps" ? &grid.march_steps
-                     : key == "orders"      ? &grid.orders
-                                            : nullptr;
+        int* field = key == "radii"                 ? &grid.radii
+                     : key == "polar"               ? &grid.polar
+                     : key == "polar_forward_thick" ? &grid.polar_forward_thick
+                     : key == "zenith"              ? &grid.zenith
+                     : key == "azimuth"             ? &grid.azimuth
+                     : key == "march_steps"         ? &grid.march_steps
+                     : key == "orders"              ? &grid.orders
+                                                    : nullptr;
         if (!field) throw py::value_error("grid." + key + ": unknown key");
         *field = item.second.cast<int>();
     }

@@ -23,9 +23,10 @@ namespace airlight {
 namespace {
 
 // Bumped whenever the solver or the table's layout changes: older files on disk are ignored.
-constexpr int TABLE_FILE_VERSION = 8;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
+constexpr int TABLE_FILE_VERSION = 9;  // 2: the orders beyond 18 (physics.md 2.7); 3: cubic between nodes (2.3);
                                        // 4, 5: polar nodes graded toward the terminator (2.14); 6, 7: entry angles
-                                       // dense across the terminator (3.2); 8: 24 radii, steps levelled off (2.7)
+                                       // dense across the terminator (3.2); 8: 24 radii, steps levelled off (2.7);
+                                       // 9: 48 polar nodes for thick, forward-scattering slices (2.6)
 
 // Where built tables are kept: $AIRLIGHT_CACHE_DIR, else $XDG_CACHE_HOME/airlight, else
 // ~/.cache/airlight; empty (no disk cache) when none can be named.

@@ -79,6 +79,7 @@ ParticleTableShape particle_table_shape(ParticleTableQuality quality) {
         shape.steps = 16;
         shape.grid.radii = 8;
         shape.grid.polar = 12;
+        shape.grid.polar_forward_thick = 0;  // a preview keeps its 12
         shape.grid.zenith = 12;
         shape.grid.azimuth = 8;
         shape.grid.march_steps = 8;

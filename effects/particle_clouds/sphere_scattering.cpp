@@ -103,6 +103,7 @@ void validate_sphere_grid(const SphereGrid& grid) {
     };
     check("radii", grid.radii, 2, 256);
     check("polar", grid.polar, 2, 256);
+    if (grid.polar_forward_thick != 0) check("polar_forward_thick", grid.polar_forward_thick, 2, 256);
     check("zenith", grid.zenith, 3, 256);
     check("azimuth", grid.azimuth, 2, 256);
     check("march_steps", grid.march_steps, 1, 4096);
@@ -110,6 +111,13 @@ void validate_sphere_grid(const SphereGrid& grid) {
     if (!(grid.surface_step >= 1e-3 && grid.surface_step <= 1.0))
         throw std::invalid_argument("grid.surface_step: must be in [0.001, 1] mean free paths, got " +
                                     std::to_string(grid.surface_step));
+}
+
+SphereGrid sphere_grid_for(const SphereGrid& grid, double tau, double g) {
+    SphereGrid solved = grid;
+    if (grid.polar_forward_thick > 0 && tau >= SphereGrid::kForwardThickTau && g >= SphereGrid::kForwardThickG)
+        solved.polar = std::max(grid.polar, grid.polar_forward_thick);
+    return solved;
 }
 
 struct SphereScattering::Impl {
@@ -701,7 +709,7 @@ SphereScattering::SphereScattering(double tau, double g, const SphereGrid& grid)
     if (!(tau >= 1e-4 && tau <= 1e3)) throw std::invalid_argument("tau: must be in [1e-4, 1000]");
     if (!(g >= 0.0 && g <= 0.99)) throw std::invalid_argument("g: must be in [0, 0.99]");
     validate_sphere_grid(grid);
-    impl_ = std::make_unique<Impl>(tau, g, grid);
+    impl_ = std::make_unique<Impl>(tau, g, sphere_grid_for(grid, tau, g));
     impl_->solve();
 }
 

@@ -35,8 +35,15 @@ private:
 // How finely the light field inside the sphere is resolved (physics.md
 // section 2.3; the defaults are chosen in effects/particle_clouds/docs/).
 struct SphereGrid {
-    int radii = 24;        // radial nodes, graded toward the surface in optical depth (eq. 2.7)
-    int polar = 32;        // the position's angle from the sun's axis, [0, pi], graded toward the terminator
+    int radii = 24;  // radial nodes, graded toward the surface in optical depth (eq. 2.7)
+    int polar = 32;  // the position's angle from the sun's axis, [0, pi], graded toward the terminator
+    // The polar nodes of thick, forward-scattering particles (tau >= kForwardThickTau and g >=
+    // kForwardThickG; at least `polar`): their diffuse light, carried forward over many mean free paths,
+    // still varies across the graded nodes' coarse steps toward the poles: 32 nodes left the side- and
+    // back-lit rays of a tau = 50, g = 0.9 particle 6-9 % dark (physics.md section 2.6). 0: `polar` everywhere.
+    int polar_forward_thick = 48;
+    static constexpr double kForwardThickTau = 10.0;
+    static constexpr double kForwardThickG = 0.7;
     int zenith = 32;       // a direction's angle from the outward normal there, [0, pi]
     int azimuth = 16;      // its azimuth about the normal from the sun's side, [0, pi] (mirror symmetry)
     int march_steps = 16;  // steps of each ray integral, uniform in 1 - transmittance (eq. 2.4)
@@ -54,6 +61,10 @@ struct SphereGrid {
 
 // Throws std::invalid_argument naming the field when a resolution is out of range.
 void validate_sphere_grid(const SphereGrid& grid);
+
+// The grid a particle of optical radius tau and asymmetry g is solved on: `grid` with its polar nodes
+// raised to polar_forward_thick for thick, forward-scattering particles.
+SphereGrid sphere_grid_for(const SphereGrid& grid, double tau, double g);
 
 // The solved light field of one sphere: the source function of every order
 // >= 2 on the grid (order 1 is analytic, eq. 2.2).
@@ -80,7 +91,7 @@ public:
 
     double tau() const;
     double g() const;
-    const SphereGrid& grid() const;
+    const SphereGrid& grid() const;  // the grid solved on: sphere_grid_for(grid, tau, g)
 
 private:
     struct Impl;

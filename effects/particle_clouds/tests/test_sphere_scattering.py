@@ -176,7 +176,7 @@ def test_light_entering_where_the_sun_grazes_matches_the_path_tracer(tau: float,
 
 
 @pytest.mark.slow
-@pytest.mark.parametrize(("tau", "g"), [(20.0, 0.0), (20.0, 0.5), (50.0, 0.0)])
+@pytest.mark.parametrize(("tau", "g"), [(20.0, 0.0), (20.0, 0.5), (50.0, 0.0), (50.0, 0.9)])
 def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float, g: float) -> None:
     # Every order, lit side to the sun's shadow, against Mitsuba 3 at unlimited depth without Russian
     # roulette (stored by bench/sphere_against_mitsuba.py --json with its standard errors): 2 % or 4
@@ -184,7 +184,9 @@ def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float
     # other, tau = 50's side-lit centre at +2.6 %, z = 3.3, is mostly Mitsuba's low order 1 there,
     # physics.md 2.6). The shadowed side is where linear interpolation between nodes diffused light
     # (section 2.3: 22 of the 25 rays of tau = 20, g = 0 failed, by up to 2.4x) and where coarse radial
-    # steps near a tau = 50 particle's centre darkened the deepest shadow by 12-24 % (eq. 2.7).
+    # steps near a tau = 50 particle's centre darkened the deepest shadow by 12-24 % (eq. 2.7). At g = 0.9
+    # 32 polar nodes left the side- and back-lit rays of tau = 50 6-9 % dark (z to -4.3): thick, forward-scattering
+    # particles are solved on 48 (SphereGrid::polar_forward_thick, physics.md 2.6).
     ref = json.loads((Path(__file__).resolve().parent / "sphere_mitsuba_reference.json").read_text())
     case = next(c for c in ref["cases"] if c["tau"] == tau and c["g"] == g)
     total = ref["columns"].index("total")
@@ -194,6 +196,25 @@ def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float
     keep = mean > 1e-3 * mean.max()
     assert keep.sum() >= 20
     np.testing.assert_array_less(np.abs(mine - mean)[keep], np.maximum(0.02 * mean, 4.0 * se)[keep])
+
+
+def test_thick_forward_scattering_particles_are_solved_on_more_polar_nodes() -> None:
+    # SphereGrid::polar_forward_thick: from tau = 10 and g = 0.7 on, the polar nodes are raised to it (and
+    # only then): the same rays as with those polar nodes given outright, and below either threshold the
+    # same as without. A small grid, so the solves take a second.
+    small = {"radii": 6, "zenith": 8, "azimuth": 4, "orders": 3, "march_steps": 4}
+    origins, dirs = orthographic_rays(VIEWS["side-lit"], [(0.0, 0.0), (0.5, 0.3), (-0.6, 0.6)])
+
+    def light(tau: float, g: float, grid: dict) -> np.ndarray:
+        return solve(tau, g, SUN, origins, dirs, {**small, **grid}, 64)
+
+    raised = {"polar": 8, "polar_forward_thick": 12}
+    given = {"polar": 12, "polar_forward_thick": 0}
+    np.testing.assert_array_equal(light(10.0, 0.7, raised), light(10.0, 0.7, given))
+    for tau, g in [(9.9, 0.7), (10.0, 0.69)]:
+        plain = light(tau, g, {"polar": 8, "polar_forward_thick": 0})
+        np.testing.assert_array_equal(light(tau, g, raised), plain)
+        assert not np.array_equal(light(tau, g, given), plain)
 
 
 @pytest.mark.parametrize(("grid", "field"), [({"radii": 1}, "grid.radii"), ({"zenith": 0}, "grid.zenith"),
