@@ -185,8 +185,8 @@ def test_a_thick_particles_total_light_matches_the_stored_path_tracer(tau: float
     # physics.md 2.6). The shadowed side is where linear interpolation between nodes diffused light
     # (section 2.3: 22 of the 25 rays of tau = 20, g = 0 failed, by up to 2.4x) and where coarse radial
     # steps near a tau = 50 particle's centre darkened the deepest shadow by 12-24 % (eq. 2.7). At g = 0.9
-    # 32 polar nodes left the side- and back-lit rays of tau = 50 6-9 % dark (z to -4.3): thick, forward-scattering
-    # particles are solved on 48 (SphereGrid::polar_forward_thick, physics.md 2.6).
+    # 32 polar nodes left the side- and back-lit rays of tau = 50 6-9 % dark (z to -4.3): thick,
+    # forward-scattering particles are solved on 48 (SphereGrid::polar_forward_thick, physics.md 2.6).
     ref = json.loads((Path(__file__).resolve().parent / "sphere_mitsuba_reference.json").read_text())
     case = next(c for c in ref["cases"] if c["tau"] == tau and c["g"] == g)
     total = ref["columns"].index("total")
