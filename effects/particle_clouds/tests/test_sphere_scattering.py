@@ -220,7 +220,9 @@ def test_thick_forward_scattering_particles_are_solved_on_more_polar_nodes() -> 
 @pytest.mark.parametrize(("grid", "field"), [({"radii": 1}, "grid.radii"), ({"zenith": 0}, "grid.zenith"),
                                              ({"orders": 0}, "grid.orders"), ({"stepz": 3}, "grid.stepz"),
                                              ({"surface_step": 0.0}, "grid.surface_step"),
-                                             ({"surface_step": float("nan")}, "grid.surface_step")])
+                                             ({"surface_step": float("nan")}, "grid.surface_step"),
+                                             ({"polar_forward_thick": 1}, "grid.polar_forward_thick"),
+                                             ({"polar_forward_thick": -48}, "grid.polar_forward_thick")])
 def test_a_bad_grid_is_a_clear_error(grid: dict, field: str) -> None:
     origins, dirs = orthographic_rays([1.0, 0.0, 0.0], [(0.0, 0.0)])
     with pytest.raises(ValueError, match=field):
